@@ -1,0 +1,40 @@
+// pathbench: command line entry. Subcommands live in their own files.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <exception>
+
+#include "pathbench/common/errors.h"
+#include "render_command.h"
+#include "reproduce_command.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"pathbench: CPU/GPU path-tracing benchmark suite"};
+  app.require_subcommand(1);
+  pb::app::RenderOptions render;
+  auto* render_cmd = app.add_subcommand("render", "render one image and write its run report");
+  pb::app::add_render_options(*render_cmd, render);
+  pb::app::ReproduceOptions reproduce;
+  auto* reproduce_cmd = app.add_subcommand("reproduce", "run the 2015 paper's experiment and print the table");
+  pb::app::add_reproduce_options(*reproduce_cmd, reproduce);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);  // prints the message
+    return pb::kExitBadInput;
+  }
+  try {
+    if (render_cmd->parsed()) return pb::app::run_render(render);
+    if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
+  } catch (const pb::InputError& e) {
+    fmt::print(stderr, "pathbench: error: {}\n", e.what());
+    return pb::kExitBadInput;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "pathbench: failed: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,121 @@
+#include "render_command.h"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/common/image_io.h"
+#include "pathbench/common/scene_library.h"
+#include "pathbench/cpu/render.h"
+#if PATHBENCH_HAVE_CUDA
+#include "pathbench/gpu/render.h"
+#endif
+
+namespace pb::app {
+
+void add_render_options(CLI::App& cmd, RenderOptions& o) {
+  cmd.add_option("--scene", o.scene, "built-in scene name or a .json / .obj file")->capture_default_str();
+  cmd.add_option("--width", o.settings.width, "image width in pixels")->capture_default_str();
+  cmd.add_option("--height", o.settings.height, "image height in pixels")->capture_default_str();
+  cmd.add_option("--spp", o.settings.spp, "samples per pixel")->capture_default_str();
+  auto* b = cmd.add_option("--bounces", o.settings.max_bounces, "diffuse bounces (the paper: 2)")->capture_default_str();
+  cmd.add_flag("--converged", o.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
+  cmd.add_flag("--rr,!--no-rr", o.settings.russian_roulette, "Russian roulette (default: only with --converged)");
+  cmd.add_option("--sampling", o.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
+  cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
+  cmd.add_option("--strategy", o.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
+  cmd.add_option("--paths-in-flight", o.settings.paths_in_flight, "wavefront pool size (0: device default)");
+  cmd.add_option("--threads", o.settings.threads, "CPU threads (0: all)")->capture_default_str();
+  cmd.add_option("--seed", o.settings.seed, "random seed")->capture_default_str();
+  cmd.add_option("--out", o.out, "image file: .exr, .png or .pfm");
+  cmd.add_option("--variance-out", o.variance_out, "variance-of-the-mean image (.exr or .pfm)");
+  cmd.add_option("--report", o.report, "run report (.json)");
+  cmd.add_flag("--profile", o.profile, "print a per-stage GPU profile");
+  cmd.add_flag("--quiet", o.quiet, "no progress bar and no summary");
+}
+
+void finish_render_options(RenderOptions& o) {
+  o.settings.sampling = parse_sampling(o.sampling);
+  o.settings.strategy = parse_strategy(o.strategy);
+  o.settings.device = parse_device(o.device);
+  if (o.converged) {
+    o.settings.max_bounces = -1;
+    o.settings.russian_roulette = true;
+  }
+  o.settings.variance = !o.variance_out.empty();
+  o.settings.progress = !o.quiet;
+  o.settings.validate();
+  for (const std::string* path : {&o.out, &o.variance_out}) {
+    if (path->empty()) continue;
+    std::string ext = std::filesystem::path(*path).extension().string();
+    if (ext != ".exr" && ext != ".png" && ext != ".pfm")
+      throw InputError(fmt::format("{}: unsupported image type '{}' (use .exr, .png or .pfm)", *path, ext));
+    if (ext != ".pfm" && !image_io_has_oiio())
+      throw InputError(fmt::format("{}: this build has no OpenImageIO (PATHBENCH_OIIO=OFF); write .pfm instead", *path));
+  }
+  if (!o.report.empty() && std::filesystem::path(o.report).extension() != ".json")
+    throw InputError(fmt::format("--report {}: the report is JSON; name it .json", o.report));
+}
+
+bool gpu_available(std::string* why_not) {
+#if PATHBENCH_HAVE_CUDA
+  return pb::gpu::device_available(why_not);
+#else
+  if (why_not) *why_not = "this build has no CUDA tracer (configure with -DPATHBENCH_CUDA=ON and nvcc on PATH)";
+  return false;
+#endif
+}
+
+void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile) {
+  if (s.device == Device::Cpu) {
+    cpu::render(scene, s, film, report);
+    return;
+  }
+  std::string why;
+  if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+#if PATHBENCH_HAVE_CUDA
+  gpu::render(scene, s, film, report, profile);
+#else
+  (void)profile;
+#endif
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::filesystem::path p(path);
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error(fmt::format("{}: write failed", path));
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+int run_render(RenderOptions& o) {
+  finish_render_options(o);
+  const Scene scene = load_scene(o.scene);
+  Film film(o.settings.width, o.settings.height, o.settings.variance);
+  RunReport report;
+  render_on_device(scene, o.settings, film, report, o.profile);
+
+  if (!o.out.empty()) write_image(o.out, film.mean(), film.width(), film.height());
+  if (!o.variance_out.empty()) write_image(o.variance_out, film.variance_of_mean(), film.width(), film.height());
+  if (!o.report.empty()) write_text_file(o.report, report.to_json().dump(2) + "\n");
+  if (!o.quiet) {
+    fmt::print("{} {}x{} {} spp, {} bounces, {} sampling, {}/{}: {:.3f} s, {:.2f} M rays/s ({} rays, {} paths",
+               scene.name, o.settings.width, o.settings.height, o.settings.spp,
+               o.settings.max_bounces < 0 ? std::string("unbounded") : std::to_string(o.settings.max_bounces),
+               to_string(o.settings.sampling), to_string(o.settings.device), to_string(o.settings.strategy),
+               report.seconds, report.rays_per_second() / 1e6, report.rays.total(), report.paths);
+    if (report.discarded_samples) fmt::print(", {} discarded", report.discarded_samples);
+    fmt::print(")\n");
+    if (!o.out.empty()) fmt::print("image: {}\n", o.out);
+    if (!o.report.empty()) fmt::print("report: {}\n", o.report);
+  }
+  return 0;
+}
+
+}  // namespace pb::app

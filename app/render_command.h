@@ -1,0 +1,36 @@
+#pragma once
+// `pathbench render`: one render to an image and a report.
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "pathbench/common/film.h"
+#include "pathbench/common/report.h"
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+
+namespace pb::app {
+
+struct RenderOptions {
+  std::string scene = "paper-cornell";
+  RenderSettings settings;
+  std::string sampling = "nee", strategy = "pixel", device = "cpu";
+  bool converged = false;
+  std::string out, report, variance_out;
+  bool profile = false;
+  bool quiet = false;
+};
+
+void add_render_options(CLI::App& cmd, RenderOptions& o);
+// Turns the parsed strings into settings; throws InputError.
+void finish_render_options(RenderOptions& o);
+int run_render(RenderOptions& o);
+
+// Renders on the device named in the settings (CPU, or GPU where built).
+void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile);
+bool gpu_available(std::string* why_not);
+
+// Writes text to `path` through a temporary file and a rename.
+void write_text_file(const std::string& path, const std::string& text);
+
+}  // namespace pb::app

@@ -1,0 +1,70 @@
+#pragma once
+// Per-pixel radiance sums in 64-bit fixed point. Integer addition is exact and
+// associative, so the sum does not depend on the order samples arrive in (pixel vs
+// ray-parallel, 1 or 64 threads, CPU atomics or CUDA atomicAdd): images from any
+// strategy are bit-identical, and 10^6 samples do not drift the way a float or even a
+// double running sum does. The scale is a power of two chosen per render from the
+// scene's brightest emitter and the sample count, so the sum cannot overflow unless
+// the mean pixel value exceeds 1024 x the brightest emission.
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "pathbench/common/math.h"
+
+namespace pb {
+
+// What a sample turns into on the film; the same function on CPU and GPU.
+PB_HD int64_t quantize_radiance(float v, double scale) { return int64_t(std::llrint(double(v) * scale)); }
+
+struct FilmView {
+  int64_t* sum;        // 3 per pixel, fixed point
+  uint32_t* count;     // samples per pixel
+  double* sum_sq;      // 3 per pixel, plain double (variance estimate); null if off
+  double scale;
+  uint32_t width, height;
+};
+
+class Film {
+ public:
+  Film() = default;
+  Film(uint32_t width, uint32_t height, bool variance);
+
+  // Picks the fixed-point scale for `spp` samples of a scene whose brightest
+  // emission channel is `max_emission`, and zeroes the sums.
+  void begin(uint64_t spp, float max_emission);
+  static double choose_scale(uint64_t spp, float max_emission);
+
+  // Sample value -> film; false (and nothing added) when any channel is NaN or
+  // infinite, or so large it would overflow: the caller counts it as discarded.
+  bool add(uint32_t pixel, Vec3f L);         // single writer per pixel
+  bool add_atomic(uint32_t pixel, Vec3f L);  // many writers
+  static bool acceptable(Vec3f L, double scale);
+
+  uint32_t width() const { return width_; }
+  uint32_t height() const { return height_; }
+  size_t pixels() const { return size_t(width_) * height_; }
+  bool has_variance() const { return !sum_sq_.empty(); }
+  double scale() const { return scale_; }
+  FilmView view();
+  size_t bytes() const;
+
+  // Mean radiance per pixel, RGB interleaved, row 0 at the top.
+  std::vector<float> mean() const;
+  // Variance of the per-pixel mean (sample variance / n), RGB; empty if not kept.
+  std::vector<float> variance_of_mean() const;
+  const std::vector<uint32_t>& counts() const { return count_; }
+  const std::vector<int64_t>& raw_sums() const { return sum_; }
+  std::vector<int64_t>& raw_sums() { return sum_; }
+  std::vector<uint32_t>& counts() { return count_; }
+  std::vector<double>& raw_sum_sq() { return sum_sq_; }
+
+ private:
+  uint32_t width_ = 0, height_ = 0;
+  double scale_ = 1;
+  std::vector<int64_t> sum_;
+  std::vector<uint32_t> count_;
+  std::vector<double> sum_sq_;
+};
+
+}  // namespace pb

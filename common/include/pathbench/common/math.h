@@ -1,0 +1,65 @@
+#pragma once
+// Small vector type templated on the scalar (float or double): the path step, the
+// sampling and the intersection code are all written against Vec3<T>.
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+#include "pathbench/common/hd.h"
+
+namespace pb {
+
+template <class T> constexpr T kPi = T(3.14159265358979323846);
+template <class T> constexpr T kInvPi = T(0.31830988618379067154);
+
+template <class T> struct Vec3 {
+  T x, y, z;
+  PB_HD T operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  PB_HD T& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+  template <class U> PB_HD explicit operator Vec3<U>() const { return {U(x), U(y), U(z)}; }
+};
+using Vec3f = Vec3<float>;
+using Vec3d = Vec3<double>;
+
+template <class T> PB_HD Vec3<T> operator+(Vec3<T> a, Vec3<T> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+template <class T> PB_HD Vec3<T> operator-(Vec3<T> a, Vec3<T> b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+template <class T> PB_HD Vec3<T> operator-(Vec3<T> a) { return {-a.x, -a.y, -a.z}; }
+template <class T> PB_HD Vec3<T> operator*(Vec3<T> a, Vec3<T> b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+template <class T> PB_HD Vec3<T> operator*(Vec3<T> a, T s) { return {a.x * s, a.y * s, a.z * s}; }
+template <class T> PB_HD Vec3<T> operator*(T s, Vec3<T> a) { return {a.x * s, a.y * s, a.z * s}; }
+template <class T> PB_HD Vec3<T> operator/(Vec3<T> a, T s) { return {a.x / s, a.y / s, a.z / s}; }
+template <class T> PB_HD Vec3<T>& operator+=(Vec3<T>& a, Vec3<T> b) { a = a + b; return a; }
+template <class T> PB_HD Vec3<T>& operator*=(Vec3<T>& a, Vec3<T> b) { a = a * b; return a; }
+template <class T> PB_HD Vec3<T>& operator*=(Vec3<T>& a, T s) { a = a * s; return a; }
+
+template <class T> PB_HD T dot(Vec3<T> a, Vec3<T> b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+template <class T> PB_HD Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+template <class T> PB_HD T length(Vec3<T> a) { return std::sqrt(dot(a, a)); }
+template <class T> PB_HD Vec3<T> normalize(Vec3<T> a) { return a / length(a); }
+template <class T> PB_HD T pmin(T a, T b) { return a < b ? a : b; }
+template <class T> PB_HD T pmax(T a, T b) { return a > b ? a : b; }
+template <class T> PB_HD T max_component(Vec3<T> a) { return pmax(a.x, pmax(a.y, a.z)); }
+template <class T> PB_HD Vec3<T> vmin(Vec3<T> a, Vec3<T> b) { return {pmin(a.x, b.x), pmin(a.y, b.y), pmin(a.z, b.z)}; }
+template <class T> PB_HD Vec3<T> vmax(Vec3<T> a, Vec3<T> b) { return {pmax(a.x, b.x), pmax(a.y, b.y), pmax(a.z, b.z)}; }
+template <class T> PB_HD Vec3<T> vabs(Vec3<T> a) { return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}; }
+template <class T> PB_HD bool is_zero(Vec3<T> a) { return a.x == T(0) && a.y == T(0) && a.z == T(0); }
+template <class T> PB_HD bool is_finite(Vec3<T> a) {
+  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+}
+template <class T> PB_HD T luminance(Vec3<T> c) { return T(0.2126) * c.x + T(0.7152) * c.y + T(0.0722) * c.z; }
+
+// Orthonormal basis around a unit vector n (Duff et al. 2017, branchless).
+template <class T> struct Frame {
+  Vec3<T> s, t, n;
+  PB_HD static Frame from_normal(Vec3<T> n) {
+    T sign = std::copysign(T(1), n.z);
+    T a = T(-1) / (sign + n.z);
+    T b = n.x * n.y * a;
+    return {{T(1) + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
+  }
+  PB_HD Vec3<T> to_world(Vec3<T> v) const { return s * v.x + t * v.y + n * v.z; }
+};
+
+}  // namespace pb

@@ -1,0 +1,159 @@
+#pragma once
+// The path step, written once for every tracer and device. A tracer only
+//   1. starts a path with path_begin,
+//   2. finds the triangle its ray hits (path ends on a miss),
+//   3. calls path_hit with that hit, which adds emission, may ask for one shadow
+//      ray, samples the next direction and applies Russian roulette,
+//   4. traces the shadow ray, if any, and calls shadow_unoccluded when it is clear,
+//   5. loops to 2 while path_hit says Continue, then hands path_radiance to the film.
+// Everything random comes from the (seed, pixel, sample, bounce) stream, so the order
+// in which a tracer runs these steps across paths cannot change the image.
+#include <cstdint>
+
+#include "pathbench/common/camera.h"
+#include "pathbench/common/ray_offset.h"
+#include "pathbench/common/rng.h"
+#include "pathbench/common/sampling.h"
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+#include "pathbench/common/surface_hit.h"
+
+namespace pb {
+
+template <class T> struct PathState {
+  Ray<T> ray;
+  Vec3<T> beta;      // path throughput
+  Vec3<T> L;         // radiance gathered so far
+  T bsdf_pdf;        // solid-angle pdf with which ray.d was sampled (for MIS)
+  uint32_t pixel;
+  uint32_t sample;
+  uint32_t depth;    // diffuse bounces taken so far
+};
+
+// A shadow ray from a shading point to a point on an emitter: the emitter is visible
+// when nothing is hit for t in (0, 1) along the unnormalised direction.
+template <class T> struct ShadowQuery {
+  Ray<T> ray;
+  Vec3<T> contribution;  // added to the path's radiance if unoccluded
+};
+
+enum class PathEvent : uint32_t { Continue = 0, Done = 1 };
+
+template <class T> PB_HD T mean3(Vec3<T> v) { return (v.x + v.y + v.z) * T(1.0 / 3.0); }
+
+template <class T>
+PB_HD void path_begin(const SceneView& s, const PathConfig& c, uint32_t pixel, uint32_t sample,
+                      PathState<T>& st) {
+  const Uniform4 u = RngStream{pixel, c.seed}.draw(sample, 0, kRngCamera);
+  st.ray = camera_ray<T>(s.camera, pixel % c.width, pixel / c.width, c.width, c.height, u.v[0], u.v[1]);
+  st.beta = {T(1), T(1), T(1)};
+  st.L = {T(0), T(0), T(0)};
+  st.bsdf_pdf = T(0);
+  st.pixel = pixel;
+  st.sample = sample;
+  st.depth = 0;
+}
+
+// Area density of light sampling at a point of an emitter with emission `Le`:
+// emitters are chosen in proportion to area * mean(Le), then a point uniformly.
+template <class T> PB_HD T emitter_area_pdf(const SceneView& s, Vec3f Le) {
+  return T(mean3(Le)) / T(s.emitter_power_total);
+}
+
+// Index of the emitter whose CDF interval holds u (binary search).
+PB_HD uint32_t pick_emitter(const SceneView& s, float u) {
+  uint32_t lo = 0, hi = s.num_emitters - 1;
+  while (lo < hi) {
+    uint32_t mid = (lo + hi) / 2;
+    if (u < s.emitter_cdf[mid]) hi = mid; else lo = mid + 1;
+  }
+  return lo;
+}
+
+template <class T>
+PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& st, const SurfaceHit<T>& h,
+                         ShadowQuery<T>& shadow, bool& wants_shadow) {
+  wants_shadow = false;
+  const Material& m = s.material_of(h.prim);
+  const T cos_o = -dot(h.ng, st.ray.d);  // > 0: the ray hit the front side
+
+  // 1. Emission (one-sided), weighted against light sampling when that could have
+  //    found this point too.
+  if (cos_o > T(0) && !is_zero(m.emission)) {
+    T w = T(1);
+    if (c.sampling == Sampling::Nee && st.depth > 0) {
+      T pdf_light = emitter_area_pdf<T>(s, m.emission) * h.t * h.t / cos_o;
+      w = power_heuristic(st.bsdf_pdf, pdf_light);
+    }
+    st.L += st.beta * Vec3<T>(m.emission) * w;
+  }
+
+  // 2. The bounce budget is spent, or the surface does not reflect.
+  if (c.max_bounces >= 0 && st.depth >= uint32_t(c.max_bounces)) return PathEvent::Done;
+  if (is_zero(m.albedo)) return PathEvent::Done;
+
+  const Vec3<T> n = cos_o >= T(0) ? h.ng : -h.ng;  // two-sided: face the incoming ray
+  const Vec3<T> f = Vec3<T>(m.albedo) * kInvPi<T>;
+  const uint32_t vertex = st.depth + 1;
+  const RngStream rng{st.pixel, c.seed};
+  const Uniform4 ub = rng.draw(st.sample, vertex, kRngBsdf);
+  const Vec3<T> origin = offset_ray_origin(h.p, n, s.offset);
+
+  // 3. Light sampling.
+  if (c.sampling == Sampling::Nee && s.num_emitters > 0) {
+    const uint32_t tri_id = s.emitters[pick_emitter(s, ub.v[3])];
+    const Triangle tri = s.triangles[tri_id];
+    const Vec3<T> v0 = Vec3<T>(s.positions[tri.v[0]]);
+    const Vec3<T> e1 = Vec3<T>(s.positions[tri.v[1]]) - v0;
+    const Vec3<T> e2 = Vec3<T>(s.positions[tri.v[2]]) - v0;
+    const Uniform4 ul = rng.draw(st.sample, vertex, kRngLight);
+    const Barycentrics<T> b = sample_uniform_triangle(T(ul.v[0]), T(ul.v[1]));
+    const Vec3<T> y = v0 + e1 * b.b1 + e2 * b.b2;
+    const Vec3<T> nl = normalize(cross(e1, e2));
+    Vec3<T> wi = y - h.p;
+    const T dist2 = dot(wi, wi);
+    wi = wi / std::sqrt(dist2);
+    const T cos_s = dot(n, wi);
+    const T cos_l = -dot(nl, wi);
+    if (cos_s > T(0) && cos_l > T(0) && dist2 > T(0)) {
+      const Vec3f Le = s.material_of(tri_id).emission;
+      const T pdf_light = emitter_area_pdf<T>(s, Le) * dist2 / cos_l;
+      const T w = power_heuristic(pdf_light, cosine_hemisphere_pdf(cos_s));
+      shadow.contribution = st.beta * f * Vec3<T>(Le) * (cos_s * w / pdf_light);
+      const Vec3<T> target = offset_ray_origin(y, nl, s.offset);
+      shadow.ray = {origin, target - origin};
+      wants_shadow = true;
+    }
+  }
+
+  // 4. Next direction from the BSDF.
+  Vec3<T> local;
+  T pdf;
+  if (c.sampling == Sampling::Uniform) {
+    local = sample_uniform_hemisphere(T(ub.v[0]), T(ub.v[1]));
+    pdf = uniform_hemisphere_pdf<T>();
+  } else {
+    local = sample_cosine_hemisphere(T(ub.v[0]), T(ub.v[1]));
+    pdf = cosine_hemisphere_pdf(local.z);
+  }
+  if (!(pdf > T(0)) || !(local.z > T(0))) return PathEvent::Done;  // grazing: no contribution
+  st.beta *= f * (local.z / pdf);
+
+  // 5. Russian roulette.
+  if (c.russian_roulette && vertex >= c.rr_start_depth) {
+    const T q = pmin(max_component(st.beta), T(0.95));
+    if (!(T(ub.v[2]) < q)) return PathEvent::Done;
+    st.beta = st.beta / q;
+  }
+
+  st.ray = {origin, Frame<T>::from_normal(n).to_world(local)};
+  st.bsdf_pdf = pdf;
+  st.depth = vertex;
+  return PathEvent::Continue;
+}
+
+template <class T> PB_HD void shadow_unoccluded(PathState<T>& st, const ShadowQuery<T>& q) {
+  st.L += q.contribution;
+}
+
+}  // namespace pb

@@ -1,0 +1,29 @@
+#pragma once
+// Where scenes come from: built-in names (with parameters after a colon) and files.
+#include <string>
+#include <vector>
+
+#include "pathbench/common/scene.h"
+
+namespace pb {
+
+struct BuiltinSceneInfo {
+  std::string name;         // e.g. "paper-cornell-ico:L"
+  std::string description;
+};
+const std::vector<BuiltinSceneInfo>& builtin_scenes();
+
+// "paper-cornell", "furnace:0.5", a .json scene file or a bare .obj mesh. The result
+// is finalized. Throws InputError naming the scene or file and what is wrong.
+Scene load_scene(const std::string& name_or_path);
+
+// Built-ins, also callable directly.
+Scene make_paper_cornell();
+// Closed cube, every wall albedo `albedo` and emission `emission` (white furnace).
+Scene make_furnace(float albedo, float emission);
+
+// Scene files (scene_file.cpp).
+Scene load_scene_json(const std::string& path);
+Scene load_scene_obj(const std::string& path);
+
+}  // namespace pb

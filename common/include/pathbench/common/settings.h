@@ -1,0 +1,59 @@
+#pragma once
+// What to render and how. RenderSettings is the user's request; PathConfig is the
+// part the path step reads, small and plain so it can be passed to kernels by value.
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "pathbench/common/hd.h"
+
+namespace pb {
+
+enum class Sampling : uint32_t {
+  Uniform = 0,  // uniform hemisphere, no light sampling: the paper's estimator
+  Cosine = 1,   // cosine-weighted hemisphere, no light sampling
+  Nee = 2,      // light sampling + cosine BSDF sampling, combined by MIS (power heuristic)
+};
+enum class Strategy : uint32_t { Pixel = 0, Wavefront = 1, PaperQueue = 2 };
+enum class Device : uint32_t { Cpu = 0, Gpu = 1 };
+
+struct PathConfig {
+  int32_t max_bounces;        // diffuse reflections; -1 = unbounded (Russian roulette ends paths)
+  Sampling sampling;
+  bool russian_roulette;
+  uint32_t rr_start_depth;    // roulette applies from this bounce on
+  uint32_t width, height;
+  uint64_t seed;
+};
+
+struct RenderSettings {
+  uint32_t width = 256, height = 256;
+  uint32_t spp = 16;
+  int32_t max_bounces = 2;
+  Sampling sampling = Sampling::Nee;
+  Strategy strategy = Strategy::Pixel;
+  Device device = Device::Cpu;
+  uint64_t seed = 0;
+  bool russian_roulette = false;  // on by default only with unbounded paths (--converged)
+  uint32_t rr_start_depth = 3;
+  uint64_t paths_in_flight = 0;  // wavefront pool size; 0 = the device's default
+  int threads = 0;               // CPU threads; 0 = all
+  bool variance = false;         // also accumulate per-pixel variance
+  bool progress = true;
+
+  PathConfig path_config() const {
+    return {max_bounces, sampling, russian_roulette, rr_start_depth, width, height, seed};
+  }
+  uint64_t total_samples() const { return uint64_t(width) * height * spp; }
+  // Throws InputError (naming the offending option) on impossible settings.
+  void validate() const;
+};
+
+const char* to_string(Sampling s);
+const char* to_string(Strategy s);
+const char* to_string(Device d);
+Sampling parse_sampling(std::string_view s);  // throw InputError on unknown names
+Strategy parse_strategy(std::string_view s);
+Device parse_device(std::string_view s);
+
+}  // namespace pb

@@ -1,0 +1,94 @@
+#include "pathbench/common/film.h"
+
+#include <atomic>
+#include <cmath>
+
+namespace pb {
+
+namespace {
+// Largest per-pixel sum we allow: 2^62, leaving a factor 2 of headroom.
+constexpr double kMaxSum = 4611686018427387904.0;
+}
+
+Film::Film(uint32_t width, uint32_t height, bool variance) : width_(width), height_(height) {
+  sum_.assign(pixels() * 3, 0);
+  count_.assign(pixels(), 0);
+  if (variance) sum_sq_.assign(pixels() * 3, 0.0);
+}
+
+double Film::choose_scale(uint64_t spp, float max_emission) {
+  // A sample is expected to stay under 1024 x the brightest emission (MIS keeps
+  // light-sampled values bounded); the sum of spp of them must stay under 2^62.
+  double bound = 1024.0 * (max_emission > 0 ? double(max_emission) : 1.0) * double(spp ? spp : 1);
+  return std::exp2(std::floor(std::log2(kMaxSum / bound)));
+}
+
+void Film::begin(uint64_t spp, float max_emission) {
+  scale_ = choose_scale(spp, max_emission);
+  std::fill(sum_.begin(), sum_.end(), 0);
+  std::fill(count_.begin(), count_.end(), 0);
+  std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
+}
+
+bool Film::acceptable(Vec3f L, double scale) {
+  if (!is_finite(L)) return false;
+  const double limit = kMaxSum / 4 / scale;  // one sample may use at most a quarter of the range
+  return std::fabs(L.x) < limit && std::fabs(L.y) < limit && std::fabs(L.z) < limit;
+}
+
+bool Film::add(uint32_t pixel, Vec3f L) {
+  if (!acceptable(L, scale_)) return false;
+  int64_t* s = &sum_[size_t(pixel) * 3];
+  for (int c = 0; c < 3; ++c) s[c] += quantize_radiance(L[c], scale_);
+  ++count_[pixel];
+  if (!sum_sq_.empty())
+    for (int c = 0; c < 3; ++c) sum_sq_[size_t(pixel) * 3 + c] += double(L[c]) * double(L[c]);
+  return true;
+}
+
+bool Film::add_atomic(uint32_t pixel, Vec3f L) {
+  if (!acceptable(L, scale_)) return false;
+  int64_t* s = &sum_[size_t(pixel) * 3];
+  for (int c = 0; c < 3; ++c)
+    std::atomic_ref<int64_t>(s[c]).fetch_add(quantize_radiance(L[c], scale_), std::memory_order_relaxed);
+  std::atomic_ref<uint32_t>(count_[pixel]).fetch_add(1, std::memory_order_relaxed);
+  if (!sum_sq_.empty())
+    for (int c = 0; c < 3; ++c)
+      std::atomic_ref<double>(sum_sq_[size_t(pixel) * 3 + c]).fetch_add(double(L[c]) * double(L[c]),
+                                                                        std::memory_order_relaxed);
+  return true;
+}
+
+FilmView Film::view() {
+  return {sum_.data(), count_.data(), sum_sq_.empty() ? nullptr : sum_sq_.data(), scale_, width_, height_};
+}
+
+size_t Film::bytes() const {
+  return sum_.size() * sizeof(int64_t) + count_.size() * sizeof(uint32_t) + sum_sq_.size() * sizeof(double);
+}
+
+std::vector<float> Film::mean() const {
+  std::vector<float> out(pixels() * 3);
+  for (size_t p = 0; p < pixels(); ++p) {
+    const double n = count_[p];
+    for (int c = 0; c < 3; ++c) out[p * 3 + c] = n > 0 ? float(double(sum_[p * 3 + c]) / scale_ / n) : 0.0f;
+  }
+  return out;
+}
+
+std::vector<float> Film::variance_of_mean() const {
+  if (sum_sq_.empty()) return {};
+  std::vector<float> out(pixels() * 3);
+  for (size_t p = 0; p < pixels(); ++p) {
+    const double n = count_[p];
+    for (int c = 0; c < 3; ++c) {
+      if (n < 2) { out[p * 3 + c] = 0; continue; }
+      const double mean = double(sum_[p * 3 + c]) / scale_ / n;
+      const double var = (sum_sq_[p * 3 + c] / n - mean * mean) * n / (n - 1);  // unbiased sample variance
+      out[p * 3 + c] = float(std::max(var, 0.0) / n);
+    }
+  }
+  return out;
+}
+
+}  // namespace pb

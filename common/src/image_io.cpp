@@ -1,0 +1,118 @@
+#include "pathbench/common/image_io.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#if PATHBENCH_HAVE_OIIO
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imageio.h>
+#endif
+
+namespace pb {
+
+namespace {
+
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+float linear_to_srgb(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+// PFM stores rows bottom to top, little-endian when the scale is negative.
+void write_pfm(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
+  out << "PF\n" << w << " " << h << "\n-1.0\n";
+  for (unsigned y = h; y-- > 0;) out.write(reinterpret_cast<const char*>(&rgb[size_t(y) * w * 3]), std::streamsize(w) * 3 * 4);
+  if (!out) throw std::runtime_error(fmt::format("{}: write failed", path));
+}
+
+std::vector<float> read_pfm(const std::string& path, unsigned& w, unsigned& h) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path));
+  std::string magic;
+  double scale;
+  in >> magic >> w >> h >> scale;
+  in.get();
+  if (magic != "PF" || !in || scale >= 0) throw std::runtime_error(fmt::format("{}: not a little-endian RGB PFM", path));
+  std::vector<float> rgb(size_t(w) * h * 3);
+  for (unsigned y = h; y-- > 0;) in.read(reinterpret_cast<char*>(&rgb[size_t(y) * w * 3]), std::streamsize(w) * 3 * 4);
+  if (!in) throw std::runtime_error(fmt::format("{}: truncated", path));
+  return rgb;
+}
+
+}  // namespace
+
+bool image_io_has_oiio() { return PATHBENCH_HAVE_OIIO; }
+
+void write_image(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h) {
+  if (rgb.size() != size_t(w) * h * 3) throw std::runtime_error(fmt::format("{}: image buffer has the wrong size", path));
+  const std::string ext = extension_of(path);
+  const std::filesystem::path final_path(path);
+  if (final_path.has_parent_path()) std::filesystem::create_directories(final_path.parent_path());
+  const std::string tmp = path + ".tmp" + ext;
+  if (ext == ".pfm") {
+    write_pfm(tmp, rgb, w, h);
+  } else {
+#if PATHBENCH_HAVE_OIIO
+    using namespace OIIO;
+    auto out = ImageOutput::create(path);
+    if (!out) throw std::runtime_error(fmt::format("{}: OpenImageIO cannot write this format ({})", path, OIIO::geterror()));
+    const bool eight_bit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+    ImageSpec spec(int(w), int(h), 3, eight_bit ? TypeDesc::UINT8 : TypeDesc::FLOAT);
+    if (!out->open(tmp, spec)) throw std::runtime_error(fmt::format("{}: {}", path, out->geterror()));
+    bool ok;
+    if (eight_bit) {
+      std::vector<unsigned char> px(rgb.size());
+      for (size_t i = 0; i < rgb.size(); ++i) px[i] = (unsigned char)std::lround(linear_to_srgb(rgb[i]) * 255.0f);
+      ok = out->write_image(TypeDesc::UINT8, px.data());
+    } else {
+      ok = out->write_image(TypeDesc::FLOAT, rgb.data());
+    }
+    if (!ok || !out->close()) {
+      std::filesystem::remove(tmp);
+      throw std::runtime_error(fmt::format("{}: {}", path, out->geterror()));
+    }
+#else
+    throw std::runtime_error(fmt::format(
+        "{}: this build has no OpenImageIO (PATHBENCH_OIIO=OFF), so it cannot write '{}' files; write .pfm instead",
+        path, ext));
+#endif
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::vector<float> read_image(const std::string& path, unsigned& w, unsigned& h) {
+  if (extension_of(path) == ".pfm") return read_pfm(path, w, h);
+#if PATHBENCH_HAVE_OIIO
+  using namespace OIIO;
+  auto in = ImageInput::open(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: {}", path, OIIO::geterror()));
+  const ImageSpec& spec = in->spec();
+  w = unsigned(spec.width);
+  h = unsigned(spec.height);
+  std::vector<float> all(size_t(w) * h * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, all.data()))
+    throw std::runtime_error(fmt::format("{}: {}", path, in->geterror()));
+  std::vector<float> rgb(size_t(w) * h * 3);
+  for (size_t p = 0; p < size_t(w) * h; ++p)
+    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = all[p * spec.nchannels + std::min(c, spec.nchannels - 1)];
+  return rgb;
+#else
+  throw std::runtime_error(fmt::format("{}: this build has no OpenImageIO; only .pfm can be read", path));
+#endif
+}
+
+}  // namespace pb

@@ -1,0 +1,110 @@
+#include "pathbench/common/report.h"
+
+#include <fmt/core.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#ifndef PATHBENCH_GIT_REVISION
+#define PATHBENCH_GIT_REVISION "unknown"
+#endif
+
+namespace pb {
+
+nlohmann::json RunReport::to_json() const {
+  nlohmann::json j;
+  j["scene"] = scene;
+  j["triangles"] = triangles;
+  j["width"] = settings.width;
+  j["height"] = settings.height;
+  j["spp"] = settings.spp;
+  j["bounces"] = settings.max_bounces < 0 ? nlohmann::json("unbounded") : nlohmann::json(settings.max_bounces);
+  j["russian_roulette"] = settings.russian_roulette;
+  j["sampling"] = to_string(settings.sampling);
+  j["device"] = to_string(settings.device);
+  j["strategy"] = to_string(settings.strategy);
+  j["seed"] = settings.seed;
+  j["seconds"] = seconds;
+  if (settings.device == Device::Gpu) j["device_seconds"] = device_seconds;
+  j["rays"] = {{"total", rays.total()}, {"camera", rays.camera}, {"bounce", rays.bounce}, {"shadow", rays.shadow}};
+  j["rays_per_second"] = rays_per_second();
+  j["paths"] = paths;
+  j["samples_per_second"] = seconds > 0 ? double(paths) / seconds : 0.0;
+  j["discarded_samples"] = discarded_samples;
+  j["peak_host_bytes"] = peak_host_bytes;
+  j["tracer_host_bytes"] = tracer_host_bytes;
+  j["peak_device_bytes"] = peak_device_bytes;
+  j["state_bytes_per_path"] = state_bytes_per_path;
+  j["paths_in_flight"] = paths_in_flight;
+  j["machine"] = {{"cpu", cpu_model()}, {"hardware_threads", hardware_threads()}, {"threads", threads}};
+  j["git_revision"] = git_revision();
+  j["compiler"] = compiler_id();
+  for (auto& [k, v] : extra.items()) j[k] = v;
+  return j;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      auto pos = line.find(':');
+      if (pos != std::string::npos) {
+        std::string m = line.substr(pos + 1);
+        m.erase(0, m.find_first_not_of(' '));
+        return m;
+      }
+    }
+  }
+  return "unknown CPU";
+}
+
+int hardware_threads() { return int(std::max(1u, std::thread::hardware_concurrency())); }
+
+std::string git_revision() { return PATHBENCH_GIT_REVISION; }
+
+std::string compiler_id() {
+#if defined(__clang__)
+  return fmt::format("clang {}.{}.{}", __clang_major__, __clang_minor__, __clang_patchlevel__);
+#elif defined(__GNUC__)
+  return fmt::format("gcc {}.{}.{}", __GNUC__, __GNUC_MINOR__, __GNUC_PATCHLEVEL__);
+#else
+  return "unknown";
+#endif
+}
+
+uint64_t peak_resident_bytes() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) {
+      std::istringstream ss(line.substr(6));
+      uint64_t kb = 0;
+      ss >> kb;
+      return kb * 1024;
+    }
+  }
+  return 0;
+}
+
+std::string machine_slug() {
+  std::string m = cpu_model();
+  // "AMD EPYC 7B13 64-Core Processor" -> "amd-epyc-7b13-64-core-processor"
+  std::string out;
+  for (char c : m) {
+    if (std::isalnum(static_cast<unsigned char>(c))) out += char(std::tolower(static_cast<unsigned char>(c)));
+    else if (!out.empty() && out.back() != '-') out += '-';
+  }
+  while (!out.empty() && out.back() == '-') out.pop_back();
+  for (const char* noise : {"-processor", "-cpu"}) {
+    auto pos = out.find(noise);
+    if (pos != std::string::npos && pos + std::string(noise).size() == out.size()) out.erase(pos);
+  }
+  return out.empty() ? "unknown-machine" : out;
+}
+
+}  // namespace pb

@@ -1,0 +1,122 @@
+#include "pathbench/common/scene.h"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "pathbench/common/errors.h"
+
+namespace pb {
+
+namespace {
+bool finite(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool non_negative(Vec3f v) { return v.x >= 0 && v.y >= 0 && v.z >= 0; }
+}  // namespace
+
+void Scene::finalize() {
+  if (triangles.empty()) throw InputError(fmt::format("{}: the scene has no triangles", name));
+  if (material_ids.size() != triangles.size())
+    throw InputError(fmt::format("{}: {} triangles but {} material ids", name, triangles.size(), material_ids.size()));
+  if (materials.empty()) throw InputError(fmt::format("{}: the scene has no materials", name));
+  for (size_t i = 0; i < positions.size(); ++i)
+    if (!finite(positions[i]))
+      throw InputError(fmt::format("{}: vertex {} has a NaN or infinite coordinate ({}, {}, {})", name, i,
+                                   positions[i].x, positions[i].y, positions[i].z));
+  for (size_t i = 0; i < materials.size(); ++i) {
+    const Material& m = materials[i];
+    std::string mname = i < material_names.size() ? material_names[i] : std::to_string(i);
+    if (!finite(m.albedo) || !non_negative(m.albedo))
+      throw InputError(fmt::format("{}: material '{}' has an albedo that is negative, NaN or infinite", name, mname));
+    if (m.albedo.x > 1 || m.albedo.y > 1 || m.albedo.z > 1)
+      throw InputError(fmt::format("{}: material '{}' has an albedo above 1 (it would create energy)", name, mname));
+    if (!finite(m.emission) || !non_negative(m.emission))
+      throw InputError(fmt::format("{}: material '{}' has an emission that is negative, NaN or infinite", name, mname));
+  }
+  if (!finite(camera.position) || !finite(camera.forward) || !finite(camera.up) || !finite(camera.right) ||
+      !(camera.tan_half_fov_y > 0) || !std::isfinite(camera.tan_half_fov_y))
+    throw InputError(fmt::format("{}: the camera is degenerate (NaN, zero direction or field of view)", name));
+
+  // Indices in range; zero-area triangles dropped (they can never be hit, and they
+  // would give NaN normals).
+  std::vector<Triangle> kept;
+  std::vector<uint32_t> kept_mat;
+  kept.reserve(triangles.size());
+  kept_mat.reserve(triangles.size());
+  dropped_triangles = 0;
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    const Triangle& t = triangles[i];
+    for (uint32_t k : t.v)
+      if (k >= positions.size())
+        throw InputError(fmt::format("{}: triangle {} refers to vertex {}, but there are only {} vertices", name, i,
+                                     k, positions.size()));
+    if (material_ids[i] >= materials.size())
+      throw InputError(fmt::format("{}: triangle {} refers to material {}, but there are only {} materials", name, i,
+                                   material_ids[i], materials.size()));
+    Vec3f e1 = positions[t.v[1]] - positions[t.v[0]];
+    Vec3f e2 = positions[t.v[2]] - positions[t.v[0]];
+    Vec3f c = cross(e1, e2);
+    float area2 = length(c);
+    if (!(area2 > 0) || !std::isfinite(area2) || !finite(normalize(c))) {
+      ++dropped_triangles;
+      continue;
+    }
+    kept.push_back(t);
+    kept_mat.push_back(material_ids[i]);
+  }
+  if (dropped_triangles)
+    fmt::print(stderr, "warning: {}: dropped {} zero-area triangle{}\n", name, dropped_triangles,
+               dropped_triangles == 1 ? "" : "s");
+  if (kept.empty()) throw InputError(fmt::format("{}: every triangle has zero area", name));
+  triangles = std::move(kept);
+  material_ids = std::move(kept_mat);
+
+  // Bounds and the offsets that follow the scene's scale.
+  bounds_min = bounds_max = positions[triangles[0].v[0]];
+  for (const Triangle& t : triangles)
+    for (uint32_t k : t.v) {
+      bounds_min = vmin(bounds_min, positions[k]);
+      bounds_max = vmax(bounds_max, positions[k]);
+    }
+  features = {};
+  features.extent = length(bounds_max - bounds_min);
+  offset = RayOffset::for_extent(features.extent);
+
+  // Emitters, chosen in proportion to their power (area x mean emission).
+  emitters.clear();
+  emitter_cdf.clear();
+  double total = 0;
+  std::vector<double> power;
+  for (uint32_t i = 0; i < triangles.size(); ++i) {
+    const Material& m = materials[material_ids[i]];
+    features.material_kinds |= 1u << uint32_t(m.kind);
+    double mean = (double(m.emission.x) + m.emission.y + m.emission.z) / 3.0;
+    if (mean <= 0) continue;
+    const Triangle& t = triangles[i];
+    double area = 0.5 * length(cross(positions[t.v[1]] - positions[t.v[0]], positions[t.v[2]] - positions[t.v[0]]));
+    emitters.push_back(i);
+    power.push_back(area * mean);
+    total += area * mean;
+  }
+  double acc = 0;
+  for (double p : power) {
+    acc += p;
+    emitter_cdf.push_back(float(acc / total));
+  }
+  if (!emitter_cdf.empty()) emitter_cdf.back() = 1.0f;
+  emitter_power_total = float(total);
+  features.has_emitters = !emitters.empty();
+}
+
+SceneView Scene::view() const {
+  return {positions.data(), triangles.data(),  material_ids.data(),        materials.data(),
+          emitters.data(),  emitter_cdf.data(), uint32_t(triangles.size()), uint32_t(emitters.size()),
+          emitter_power_total, camera,          offset};
+}
+
+float Scene::max_emission() const {
+  float m = 0;
+  for (const Material& mat : materials) m = pmax(m, max_component(mat.emission));
+  return m;
+}
+
+}  // namespace pb

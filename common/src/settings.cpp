@@ -1,0 +1,56 @@
+#include "pathbench/common/settings.h"
+
+#include <fmt/core.h>
+
+#include "pathbench/common/errors.h"
+
+namespace pb {
+
+const char* to_string(Sampling s) {
+  switch (s) {
+    case Sampling::Uniform: return "uniform";
+    case Sampling::Cosine: return "cosine";
+    case Sampling::Nee: return "nee";
+  }
+  return "?";
+}
+const char* to_string(Strategy s) {
+  switch (s) {
+    case Strategy::Pixel: return "pixel";
+    case Strategy::Wavefront: return "wavefront";
+    case Strategy::PaperQueue: return "paper-queue";
+  }
+  return "?";
+}
+const char* to_string(Device d) { return d == Device::Cpu ? "cpu" : "gpu"; }
+
+Sampling parse_sampling(std::string_view s) {
+  if (s == "uniform") return Sampling::Uniform;
+  if (s == "cosine") return Sampling::Cosine;
+  if (s == "nee") return Sampling::Nee;
+  throw InputError(fmt::format("--sampling: unknown sampling '{}' (expected uniform, cosine or nee)", s));
+}
+Strategy parse_strategy(std::string_view s) {
+  if (s == "pixel") return Strategy::Pixel;
+  if (s == "wavefront") return Strategy::Wavefront;
+  if (s == "paper-queue") return Strategy::PaperQueue;
+  throw InputError(fmt::format("--strategy: unknown strategy '{}' (expected pixel, wavefront or paper-queue)", s));
+}
+Device parse_device(std::string_view s) {
+  if (s == "cpu") return Device::Cpu;
+  if (s == "gpu") return Device::Gpu;
+  throw InputError(fmt::format("--device: unknown device '{}' (expected cpu or gpu)", s));
+}
+
+void RenderSettings::validate() const {
+  if (width == 0 || height == 0) throw InputError(fmt::format("--width/--height: the image must be at least 1x1 (got {}x{})", width, height));
+  if (uint64_t(width) * height > (uint64_t(1) << 31))
+    throw InputError(fmt::format("--width/--height: {}x{} pixels is more than 2^31", width, height));
+  if (spp == 0) throw InputError("--spp: must be at least 1");
+  if (max_bounces < -1) throw InputError("--bounces: must be >= 0");
+  if (max_bounces < 0 && !russian_roulette)
+    throw InputError("--converged without Russian roulette would never end a path");
+  if (threads < 0) throw InputError("--threads: must be >= 0 (0 = all)");
+}
+
+}  // namespace pb

@@ -1,0 +1,52 @@
+#include "embree_scene.h"
+
+#include <fmt/core.h>
+
+#include <cstring>
+#include <stdexcept>
+
+namespace pb::cpu {
+
+namespace {
+void on_error(void*, RTCError code, const char* str) {
+  fmt::print(stderr, "embree error {}: {}\n", int(code), str ? str : "");
+}
+}  // namespace
+
+bool EmbreeScene::monitor(void* self_ptr, ssize_t bytes, bool) {
+  auto* self = static_cast<EmbreeScene*>(self_ptr);
+  int64_t now = self->bytes_.fetch_add(bytes) + bytes;
+  int64_t peak = self->peak_bytes_.load();
+  while (now > peak && !self->peak_bytes_.compare_exchange_weak(peak, now)) {
+  }
+  return true;
+}
+
+EmbreeScene::EmbreeScene(const Scene& s) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
+  rtcSetDeviceErrorFunction(device_, on_error, nullptr);
+  rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeScene::monitor, this);
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), s.positions.size()));
+  std::memcpy(v, s.positions.data(), s.positions.size() * sizeof(Vec3f));
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(uint32_t), s.triangles.size()));
+  std::memcpy(idx, s.triangles.data(), s.triangles.size() * sizeof(Triangle));
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(scene_, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(scene_);
+  if (RTCError e = rtcGetDeviceError(device_); e != RTC_ERROR_NONE)
+    throw std::runtime_error(fmt::format("embree: building the scene failed (error {})", int(e)));
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+}  // namespace pb::cpu

@@ -1,0 +1,64 @@
+#include "pathbench/cpu/render.h"
+
+#include <fmt/core.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <memory>
+
+#include "embree_scene.h"
+#include "pathbench/common/errors.h"
+#include "strategies.h"
+
+namespace pb::cpu {
+
+uint64_t default_paths_in_flight(int threads) { return uint64_t(threads) * 4096; }
+
+void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report) {
+  settings.validate();
+  if (settings.strategy == Strategy::PaperQueue)
+    throw InputError("--strategy paper-queue: the paper's global queue is a GPU strategy; the CPU runs pixel or wavefront");
+  if (film.width() != settings.width || film.height() != settings.height)
+    throw std::logic_error("film size does not match the settings");
+
+  std::unique_ptr<tbb::global_control> limit;
+  if (settings.threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
+  const int threads = settings.threads > 0 ? settings.threads : tbb::this_task_arena::max_concurrency();
+
+  EmbreeScene embree(scene);
+  film.begin(settings.spp, scene.max_emission());
+  Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
+                    settings.total_samples(), settings.progress);
+  TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress};
+
+  const auto t0 = std::chrono::steady_clock::now();
+  TraceTotals totals;
+  if (settings.strategy == Strategy::Pixel) {
+    totals = render_pixel_parallel(job);
+  } else {
+    uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads);
+    totals = render_wavefront(job, pif);
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  progress.finish();
+
+  report.scene = scene.name;
+  report.triangles = scene.triangles.size();
+  report.settings = settings;
+  report.seconds = std::chrono::duration<double>(t1 - t0).count();
+  report.rays = totals.rays;
+  report.paths = totals.paths;
+  report.discarded_samples = totals.discarded;
+  report.state_bytes_per_path = totals.state_bytes_per_path;
+  report.paths_in_flight = totals.paths_in_flight;
+  report.threads = threads;
+  report.tracer_host_bytes = film.bytes() + totals.pool_bytes + uint64_t(std::max<int64_t>(0, embree.peak_bytes()));
+  report.peak_host_bytes = peak_resident_bytes();
+  report.extra["embree_bytes"] = embree.peak_bytes();
+  report.extra["film_bytes"] = film.bytes();
+  report.extra["pool_bytes"] = totals.pool_bytes;
+}
+
+}  // namespace pb::cpu

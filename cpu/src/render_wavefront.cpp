@@ -1,0 +1,179 @@
+// Ray-parallel ("wavefront") CPU strategy. Each thread owns a slice of the pool of
+// paths in flight and runs the stages over the whole slice in turn:
+//   generate (fill free slots with new samples) -> intersect (16-wide packets) ->
+//   shade (shared path step) -> shadow (16-wide packets) -> accumulate (film, free slot)
+// Memory is the pool, fixed by --paths-in-flight, never width x height x spp.
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "embree_rays.h"
+#include "pathbench/common/path.h"
+#include "strategies.h"
+
+namespace pb::cpu {
+
+namespace {
+
+constexpr int kPacket = 16;
+
+// Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
+// are neighbours on the image (coherent camera rays).
+class SampleSource {
+ public:
+  SampleSource(uint64_t total, uint32_t pixels) : total_(total), pixels_(pixels) {}
+  // Claims up to n samples; returns the first global index and sets n to the count.
+  uint64_t claim(uint64_t& n) {
+    uint64_t start = next_.fetch_add(n, std::memory_order_relaxed);
+    n = start >= total_ ? 0 : std::min(n, total_ - start);
+    return start;
+  }
+  uint32_t pixel_of(uint64_t g) const { return uint32_t(g % pixels_); }
+  uint32_t sample_of(uint64_t g) const { return uint32_t(g / pixels_); }
+
+ private:
+  std::atomic<uint64_t> next_{0};
+  uint64_t total_;
+  uint32_t pixels_;
+};
+
+struct PoolSlice {
+  explicit PoolSlice(size_t n) : state(n), shadow(n), prim(n) {
+    free.reserve(n);
+    live.reserve(n);
+    next_live.reserve(n);
+    shadowed.reserve(n);
+    done.reserve(n);
+    for (size_t i = n; i-- > 0;) free.push_back(uint32_t(i));
+  }
+  std::vector<PathState<float>> state;
+  std::vector<ShadowQuery<float>> shadow;
+  std::vector<uint32_t> prim;  // hit triangle, or RTC_INVALID_GEOMETRY_ID
+  std::vector<uint32_t> free, live, next_live, shadowed, done;
+
+  static constexpr size_t bytes_per_path =
+      sizeof(PathState<float>) + sizeof(ShadowQuery<float>) + sizeof(uint32_t) * 6;
+};
+
+struct Local {
+  RayCounts rays;
+  uint64_t paths = 0, discarded = 0;
+};
+
+void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool, Local& local) {
+  uint64_t n = pool.free.size();
+  if (n == 0) return;
+  const uint64_t start = src.claim(n);
+  for (uint64_t i = 0; i < n; ++i) {
+    const uint32_t slot = pool.free.back();
+    pool.free.pop_back();
+    path_begin(job.scene, job.config, src.pixel_of(start + i), src.sample_of(start + i), pool.state[slot]);
+    pool.live.push_back(slot);
+  }
+  local.rays.camera += n;
+}
+
+void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx) {
+  alignas(64) RTCRayHitNt<kPacket> packet;
+  alignas(64) int valid[kPacket];
+  for (size_t base = 0; base < pool.live.size(); base += kPacket) {
+    const int n = int(std::min<size_t>(kPacket, pool.live.size() - base));
+    for (int i = 0; i < kPacket; ++i) {
+      valid[i] = i < n ? -1 : 0;
+      if (i < n) set_lane(packet.ray, i, pool.state[pool.live[base + i]].ray, kInfinity);
+      packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, job.embree.handle(), &ctx, reinterpret_cast<RTCRayHit16*>(&packet));
+    for (int i = 0; i < n; ++i)
+      pool.prim[pool.live[base + i]] =
+          packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : packet.hit.primID[i];
+  }
+}
+
+void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
+  pool.next_live.clear();
+  pool.shadowed.clear();
+  for (uint32_t slot : pool.live) {
+    PathState<float>& st = pool.state[slot];
+    if (pool.prim[slot] == RTC_INVALID_GEOMETRY_ID) {
+      pool.done.push_back(slot);
+      continue;
+    }
+    bool wants_shadow;
+    const PathEvent ev =
+        path_hit(job.scene, job.config, st, surface_hit(job.scene, pool.prim[slot], st.ray), pool.shadow[slot], wants_shadow);
+    if (wants_shadow) pool.shadowed.push_back(slot);
+    if (ev == PathEvent::Continue) pool.next_live.push_back(slot);
+    else pool.done.push_back(slot);
+  }
+  local.rays.bounce += pool.next_live.size();
+  std::swap(pool.live, pool.next_live);
+}
+
+void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local) {
+  alignas(64) RTCRayNt<kPacket> packet;
+  alignas(64) int valid[kPacket];
+  for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
+    const int n = int(std::min<size_t>(kPacket, pool.shadowed.size() - base));
+    for (int i = 0; i < kPacket; ++i) {
+      valid[i] = i < n ? -1 : 0;
+      if (i < n) set_lane(packet, i, pool.shadow[pool.shadowed[base + i]].ray, 1.0f);
+    }
+    rtcOccluded16(valid, job.embree.handle(), &ctx, reinterpret_cast<RTCRay16*>(&packet));
+    for (int i = 0; i < n; ++i) {
+      const uint32_t slot = pool.shadowed[base + i];
+      if (packet.tfar[i] >= 0.0f) shadow_unoccluded(pool.state[slot], pool.shadow[slot]);
+    }
+  }
+  local.rays.shadow += pool.shadowed.size();
+}
+
+void stage_accumulate(const TraceJob& job, PoolSlice& pool, Local& local) {
+  for (uint32_t slot : pool.done) {
+    const PathState<float>& st = pool.state[slot];
+    if (!job.film.add_atomic(st.pixel, st.L)) ++local.discarded;
+    pool.free.push_back(slot);
+  }
+  local.paths += pool.done.size();
+  job.progress.advance(pool.done.size());
+  pool.done.clear();
+}
+
+}  // namespace
+
+TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
+  const uint32_t pixels = job.config.width * job.config.height;
+  SampleSource source(uint64_t(pixels) * job.spp, pixels);
+  const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
+  const uint64_t per_slice = std::max<uint64_t>(kPacket, (paths_in_flight + slices - 1) / slices);
+  tbb::combinable<Local> locals;
+  tbb::parallel_for(0, slices, [&](int) {
+    Local& local = locals.local();
+    PoolSlice pool(per_slice);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (;;) {
+      stage_generate(job, source, pool, local);
+      if (pool.live.empty()) break;
+      stage_intersect(job, pool, ctx);
+      stage_shade(job, pool, local);
+      stage_shadow(job, pool, ctx, local);
+      stage_accumulate(job, pool, local);
+    }
+  }, tbb::static_partitioner());
+  TraceTotals t;
+  locals.combine_each([&](const Local& l) {
+    t.rays += l.rays;
+    t.paths += l.paths;
+    t.discarded += l.discarded;
+  });
+  t.state_bytes_per_path = PoolSlice::bytes_per_path;
+  t.paths_in_flight = per_slice * uint64_t(slices);
+  t.pool_bytes = t.paths_in_flight * PoolSlice::bytes_per_path;
+  return t;
+}
+
+}  // namespace pb::cpu

@@ -1,0 +1,40 @@
+#pragma once
+// The CPU strategies. Both run the shared path step; they differ only in how rays
+// are grouped for Embree and how work is spread over threads.
+#include <atomic>
+#include <cstdint>
+
+#include "embree_scene.h"
+#include "pathbench/common/film.h"
+#include "pathbench/common/progress.h"
+#include "pathbench/common/report.h"
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+
+namespace pb::cpu {
+
+struct TraceJob {
+  const EmbreeScene& embree;
+  SceneView scene;
+  PathConfig config;
+  uint32_t spp;
+  Film& film;
+  Progress& progress;
+};
+
+struct TraceTotals {
+  RayCounts rays;
+  uint64_t paths = 0;
+  uint64_t discarded = 0;
+  uint64_t state_bytes_per_path = 0;
+  uint64_t paths_in_flight = 0;
+  uint64_t pool_bytes = 0;
+};
+
+// One thread per image tile; each pixel sample traced alone (rtcIntersect1/rtcOccluded1).
+TraceTotals render_pixel_parallel(const TraceJob& job);
+// Bounded pool of paths per thread; each stage runs over the whole pool, rays go to
+// Embree in 16-wide packets; finished paths are replaced by new samples.
+TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight);
+
+}  // namespace pb::cpu

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs everything pathbench needs on Debian 12: build tools and libraries from
+# apt, Python tools into .venv. Safe to run twice: it installs only what is missing.
+#   scripts/install-deps.sh            libraries + Python tools
+#   PATHBENCH_SKIP_VENV=1 scripts/install-deps.sh   libraries only
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+apt_pkgs=(build-essential cmake ninja-build pkg-config git python3 python3-venv
+          libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
+          librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
+          libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev)
+missing=()
+for p in "${apt_pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "[install-deps] apt-get install: ${missing[*]}"
+  sudo_cmd=(); [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+else
+  echo "[install-deps] apt packages: all present"
+fi
+
+if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
+  if [ ! -x "$root/.venv/bin/python" ]; then
+    echo "[install-deps] creating .venv"
+    python3 -m venv "$root/.venv"
+  fi
+  req="$root/tools/requirements.txt"
+  stamp="$root/.venv/.requirements.sha"
+  sum=$(sha256sum "$req" | cut -d' ' -f1)
+  if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$sum" ]; then
+    echo "[install-deps] pip install -r tools/requirements.txt"
+    "$root/.venv/bin/python" -m pip install -q --upgrade pip
+    "$root/.venv/bin/python" -m pip install -q -r "$req"
+    echo "$sum" > "$stamp"
+  else
+    echo "[install-deps] .venv: up to date"
+  fi
+fi
+echo "[install-deps] done"

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The README's test command: installs what is missing, builds, runs every CTest suite
+# (CPU tests; GPU tests report SKIPPED without a GPU) and the Python tests.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+scripts/install-deps.sh
+scripts/build.sh "$@"
+ctest --test-dir build --output-on-failure --timeout 1800 -j "$(nproc)"
+if compgen -G "tests/python/test_*.py" >/dev/null; then
+  .venv/bin/python -m pytest -q tests/python
+fi
