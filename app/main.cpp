@@ -4,6 +4,7 @@
 
 #include <exception>
 
+#include "compare_command.h"
 #include "pathbench/common/errors.h"
 #include "render_command.h"
 #include "reproduce_command.h"
@@ -17,6 +18,9 @@ int main(int argc, char** argv) {
   pb::app::ReproduceOptions reproduce;
   auto* reproduce_cmd = app.add_subcommand("reproduce", "run the 2015 paper's experiment and print the table");
   pb::app::add_reproduce_options(*reproduce_cmd, reproduce);
+  pb::app::CompareOptions compare;
+  auto* compare_cmd = app.add_subcommand("compare", "judge two benchmark JSON files for regressions (Mann-Whitney U)");
+  pb::app::add_compare_options(*compare_cmd, compare);
 
   try {
     app.parse(argc, argv);
@@ -29,6 +33,7 @@ int main(int argc, char** argv) {
   try {
     if (render_cmd->parsed()) return pb::app::run_render(render);
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
+    if (compare_cmd->parsed()) return pb::app::run_compare(compare);
   } catch (const pb::InputError& e) {
     fmt::print(stderr, "pathbench: error: {}\n", e.what());
     return pb::kExitBadInput;

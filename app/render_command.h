@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "device_render.h"  // render_on_device, gpu_available, write_text_file
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
@@ -25,12 +26,5 @@ void add_render_options(CLI::App& cmd, RenderOptions& o);
 // Turns the parsed strings into settings; throws InputError.
 void finish_render_options(RenderOptions& o);
 int run_render(RenderOptions& o);
-
-// Renders on the device named in the settings (CPU, or GPU where built).
-void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile);
-bool gpu_available(std::string* why_not);
-
-// Writes text to `path` through a temporary file and a rename.
-void write_text_file(const std::string& path, const std::string& text);
 
 }  // namespace pb::app

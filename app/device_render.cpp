@@ -1,0 +1,52 @@
+#include "device_render.h"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/cpu/render.h"
+#if PATHBENCH_HAVE_CUDA
+#include "pathbench/gpu/render.h"
+#endif
+
+namespace pb::app {
+
+bool gpu_available(std::string* why_not) {
+#if PATHBENCH_HAVE_CUDA
+  return pb::gpu::device_available(why_not);
+#else
+  if (why_not) *why_not = "this build has no CUDA tracer (configure with -DPATHBENCH_CUDA=ON and nvcc on PATH)";
+  return false;
+#endif
+}
+
+void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile) {
+  if (s.device == Device::Cpu) {
+    cpu::render(scene, s, film, report);
+    return;
+  }
+  std::string why;
+  if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+#if PATHBENCH_HAVE_CUDA
+  gpu::render(scene, s, film, report, profile);
+#else
+  (void)profile;
+#endif
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::filesystem::path p(path);
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error(fmt::format("{}: write failed", path));
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace pb::app

@@ -1,0 +1,82 @@
+#include "bench_context.h"
+
+#include <benchmark/benchmark.h>
+#include <embree3/rtcore_config.h>
+#include <fmt/chrono.h>
+#include <fmt/core.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <ctime>
+#include <fstream>
+
+#include "pathbench/common/report.h"
+
+#if PATHBENCH_BENCH_GPU
+#include <cuda_runtime_api.h>
+#endif
+
+namespace pb::bench {
+
+namespace {
+
+std::string first_line(const char* path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+std::string utc_now() {
+  std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", tm);
+}
+
+void add(const char* key, const std::string& value) { benchmark::AddCustomContext(key, value); }
+
+void add_gpu_context() {
+#if PATHBENCH_BENCH_GPU
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) {
+    add("gpu", "none (no CUDA device)");
+    return;
+  }
+  cudaDeviceProp prop{};
+  cudaGetDeviceProperties(&prop, 0);
+  int driver = 0, runtime = 0;
+  cudaDriverGetVersion(&driver);
+  cudaRuntimeGetVersion(&runtime);
+  add("gpu_name", prop.name);
+  add("gpu_count", std::to_string(count));
+  add("gpu_compute_capability", fmt::format("{}.{}", prop.major, prop.minor));
+  add("gpu_memory_bytes", std::to_string(prop.totalGlobalMem));
+  add("cuda_driver_api", fmt::format("{}.{}", driver / 1000, (driver % 1000) / 10));
+  add("cuda_runtime", fmt::format("{}.{}", runtime / 1000, (runtime % 1000) / 10));
+  const std::string nv = first_line("/proc/driver/nvidia/version");
+  if (!nv.empty()) add("gpu_driver", nv);
+#else
+  add("gpu", "none (built without the CUDA tracer)");
+#endif
+}
+
+}  // namespace
+
+void add_environment_context(const std::string& preset) {
+  add("pathbench_preset", preset);
+  add("cpu_model", cpu_model());
+  add("cpu_hardware_threads", std::to_string(hardware_threads()));
+  add("cpu_tbb_threads", std::to_string(tbb::this_task_arena::max_concurrency()));
+  add("machine", machine_slug());
+  add("compiler", fmt::format("{} ({})", PATHBENCH_BENCH_COMPILER, compiler_id()));
+  add("cxx_flags", PATHBENCH_BENCH_CXX_FLAGS);
+  add("build_type", PATHBENCH_BENCH_BUILD_TYPE);
+  add("embree_version", RTC_VERSION_STRING);
+  add("git_revision", git_revision());
+  add("date_utc", utc_now());
+  add("load_average_at_start", first_line("/proc/loadavg"));
+  add_gpu_context();
+}
+
+}  // namespace pb::bench

@@ -1,0 +1,139 @@
+// pathbench-bench: Google Benchmark harness for pathbench.
+//
+//   pathbench-bench --preset quick|paper|scaling [--benchmark_* options]
+//
+//   quick    smoke run (< 1 min on 2 cores): paper-cornell 64x64, 4 spp, CPU pixel and
+//            wavefront (and GPU where present), uniform and nee; Embree ray casts.
+//   paper    the 2015 paper's experiment: paper-cornell 256x256, 800 spp, 2 bounces,
+//            uniform (the paper's sampler) and nee, every strategy and device;
+//            Embree ray casts on paper-cornell.
+//   scaling  rays/s vs triangle count (scaling:N, N = 10 .. 10^7), time vs spp and
+//            vs resolution (paper-cornell); Embree ray casts on every scaling:N.
+//
+// Regression runs: --benchmark_repetitions=9 --benchmark_report_aggregates_only=false
+// --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`.
+#include <benchmark/benchmark.h>
+#include <fmt/core.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "bench_context.h"
+#include "raycast_bench.h"
+#include "render_bench.h"
+
+namespace pb::bench {
+namespace {
+
+std::vector<Device> devices() {
+  std::vector<Device> d = {Device::Cpu};
+#if PATHBENCH_BENCH_GPU
+  d.push_back(Device::Gpu);  // skipped at run time (SkipWithError) without a device
+#endif
+  return d;
+}
+
+std::vector<Strategy> strategies(Device d) {
+  if (d == Device::Cpu) return {Strategy::Pixel, Strategy::Wavefront};
+  return {Strategy::Pixel, Strategy::Wavefront, Strategy::PaperQueue};
+}
+
+RenderCase render_case(const std::string& scene, Device dev, Strategy strat, uint32_t w, uint32_t h, uint32_t spp,
+                       int bounces, Sampling sampling) {
+  RenderCase c;
+  c.scene = scene;
+  c.settings.device = dev;
+  c.settings.strategy = strat;
+  c.settings.width = w;
+  c.settings.height = h;
+  c.settings.spp = spp;
+  c.settings.max_bounces = bounces;
+  c.settings.sampling = sampling;
+  return c;
+}
+
+void preset_quick() {
+  for (Device dev : devices())
+    for (Sampling sampling : {Sampling::Uniform, Sampling::Nee})
+      for (Strategy strat : strategies(dev))
+        register_render_benchmark(render_case("paper-cornell", dev, strat, 64, 64, 4, 2, sampling));
+  register_raycast_benchmarks({"paper-cornell", 128, 128});
+  // GPU BVH ray casts (raycast/gpu/...) register here once the GPU tracer has them.
+}
+
+void preset_paper() {
+  for (Device dev : devices())
+    for (Sampling sampling : {Sampling::Uniform, Sampling::Nee})
+      for (Strategy strat : strategies(dev))
+        register_render_benchmark(render_case("paper-cornell", dev, strat, 256, 256, 800, 2, sampling));
+  register_raycast_benchmarks({"paper-cornell", 256, 256});
+  // GPU BVH ray casts (raycast/gpu/...) register here once the GPU tracer has them.
+}
+
+// Largest scaling scene; 10^7 needs several GB and about a minute per build on 2 cores.
+uint64_t scaling_max_triangles() {
+  if (const char* env = std::getenv("PATHBENCH_SCALING_MAX")) return std::strtoull(env, nullptr, 10);
+  return 10000000;
+}
+
+void preset_scaling() {
+  // Rays/s vs triangle count: renders and raw ray casts per scene, grouped by scene
+  // so each is built once. Smaller images for the largest scenes keep 2 cores sane.
+  for (uint64_t n = 10; n <= scaling_max_triangles(); n *= 10) {
+    const std::string scene = fmt::format("scaling:{}", n);
+    const uint32_t side = n >= 1000000 ? 64 : 128;
+    for (Device dev : devices())
+      for (Strategy strat : strategies(dev))
+        register_render_benchmark(render_case(scene, dev, strat, side, side, 8, 2, Sampling::Nee));
+    register_raycast_benchmarks({scene, 256, 256});
+  }
+  // Time vs spp and vs resolution (and memory vs pixels x spp), paper-cornell, nee.
+  for (Device dev : devices())
+    for (Strategy strat : strategies(dev)) {
+      for (uint32_t spp : {1u, 4u, 16u, 64u, 256u})
+        register_render_benchmark(render_case("paper-cornell", dev, strat, 128, 128, spp, 2, Sampling::Nee));
+      for (uint32_t side : {32u, 64u, 128u, 256u, 512u})
+        if (side != 128)  // 128x128 at 16 spp is in the spp sweep
+          register_render_benchmark(render_case("paper-cornell", dev, strat, side, side, 16, 2, Sampling::Nee));
+    }
+}
+
+}  // namespace
+}  // namespace pb::bench
+
+int main(int argc, char** argv) {
+  // --preset NAME / --preset=NAME, removed from argv before Google Benchmark sees it.
+  std::string preset = "quick";
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (i > 0 && std::strcmp(argv[i], "--preset") == 0) {
+      if (i + 1 >= argc) {
+        fmt::print(stderr, "pathbench-bench: --preset needs a value (quick, paper or scaling)\n");
+        return 2;
+      }
+      preset = argv[++i];
+      continue;
+    }
+    if (i > 0 && std::strncmp(argv[i], "--preset=", 9) == 0) {
+      preset = argv[i] + 9;
+      continue;
+    }
+    args.push_back(argv[i]);
+  }
+  if (preset == "quick") pb::bench::preset_quick();
+  else if (preset == "paper") pb::bench::preset_paper();
+  else if (preset == "scaling") pb::bench::preset_scaling();
+  else {
+    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper or scaling)\n", preset);
+    return 2;
+  }
+  int new_argc = int(args.size());
+  args.push_back(nullptr);
+  benchmark::Initialize(&new_argc, args.data());
+  if (benchmark::ReportUnrecognizedArguments(new_argc, args.data())) return 2;
+  pb::bench::add_environment_context(preset);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

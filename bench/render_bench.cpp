@@ -1,0 +1,101 @@
+#include "render_bench.h"
+
+#include <benchmark/benchmark.h>
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "device_render.h"
+#include "pathbench/common/errors.h"
+#include "pathbench/common/film.h"
+#include "pathbench/common/report.h"
+#include "scene_cache.h"
+
+namespace pb::bench {
+
+namespace {
+
+// Resets this process's peak resident set (VmHWM) so the next render's peak is its
+// own (Linux >= 4.0); harmless where unsupported.
+void reset_peak_rss() {
+  std::ofstream f("/proc/self/clear_refs");
+  if (f) f << "5";
+}
+
+uint64_t queue_bytes_of(const RunReport& r) {
+  if (r.settings.strategy == Strategy::Pixel) return 0;
+  for (const char* key : {"queue_bytes", "pool_bytes"})
+    if (r.extra.contains(key) && r.extra[key].is_number()) return r.extra[key].get<uint64_t>();
+  return 0;
+}
+
+void run_render(benchmark::State& state, const RenderCase& c) {
+  const RenderSettings& s = c.settings;
+  if (s.device == Device::Gpu) {
+    std::string why;
+    if (!app::gpu_available(&why)) {
+      state.SkipWithError(("no GPU: " + why).c_str());
+      return;
+    }
+  }
+  std::shared_ptr<const Scene> scene;
+  try {
+    scene = cached_scene(c.scene);
+  } catch (const InputError& e) {
+    state.SkipWithError(fmt::format("scene not available: {}", e.what()).c_str());
+    return;
+  }
+  Film film(s.width, s.height, false);
+  uint64_t rays = 0, paths = 0;
+  RunReport last;
+  uint64_t peak_host = 0, peak_device = 0, tracer_host = 0;
+  for (auto _ : state) {
+    reset_peak_rss();
+    RunReport r;
+    try {
+      app::render_on_device(*scene, s, film, r, false);
+    } catch (const std::exception& e) {
+      state.SkipWithError(e.what());
+      break;
+    }
+    state.SetIterationTime(s.device == Device::Gpu ? r.device_seconds : r.seconds);
+    rays += r.rays.total();
+    paths += r.paths;
+    peak_host = std::max(peak_host, r.peak_host_bytes);
+    peak_device = std::max(peak_device, r.peak_device_bytes);
+    tracer_host = std::max(tracer_host, r.tracer_host_bytes);
+    last = r;
+  }
+  using benchmark::Counter;
+  state.counters["rays_per_second"] = Counter(double(rays), Counter::kIsRate);
+  state.counters["paths_per_second"] = Counter(double(paths), Counter::kIsRate);
+  state.counters["peak_host_bytes"] = double(peak_host);
+  state.counters["tracer_host_bytes"] = double(tracer_host);
+  state.counters["peak_device_bytes"] = double(peak_device);
+  state.counters["state_bytes_per_path"] = double(last.state_bytes_per_path);
+  state.counters["queue_bytes"] = double(queue_bytes_of(last));
+  state.counters["paths_in_flight"] = double(last.paths_in_flight);
+  state.counters["pixels_x_spp"] = double(s.total_samples());
+  state.counters["triangles"] = double(scene->triangles.size());
+  state.counters["threads"] = double(last.threads);
+}
+
+}  // namespace
+
+std::string render_benchmark_name(const RenderCase& c) {
+  const RenderSettings& s = c.settings;
+  return fmt::format("render/{}/{}/{}/{}x{}/spp:{}/bounces:{}/{}", to_string(s.device), to_string(s.strategy), c.scene,
+                     s.width, s.height, s.spp, s.max_bounces < 0 ? std::string("unbounded") : std::to_string(s.max_bounces),
+                     to_string(s.sampling));
+}
+
+void register_render_benchmark(const RenderCase& c) {
+  RenderCase copy = c;
+  copy.settings.progress = false;
+  auto* b = benchmark::RegisterBenchmark(render_benchmark_name(copy).c_str(),
+                                         [copy](benchmark::State& st) { run_render(st, copy); });
+  b->UseManualTime()->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace pb::bench

@@ -1,0 +1,31 @@
+#pragma once
+// Render benchmarks: one full render per iteration through pb::app::render_on_device,
+// named render/<device>/<strategy>/<scene>/<W>x<H>/spp:<N>/bounces:<B>/<sampling>.
+//
+// Time is manual: the RunReport's render time (CPU: host clock around the render,
+// after the Embree build; GPU: CUDA events, RunReport.device_seconds), so rays/s
+// here is the RunReport's rays/s. Counters:
+//   rays_per_second, paths_per_second   rates over all rays / paths traced (kIsRate)
+//   peak_host_bytes     process peak resident set during the render (VmHWM, reset
+//                       before each iteration; includes the scene and the program)
+//   tracer_host_bytes   what the tracer allocated itself: film, path pool, BVH
+//   peak_device_bytes   GPU memory at its peak (0 on the CPU)
+//   state_bytes_per_path  bytes of path state per path (the paper: 48)
+//   queue_bytes         bytes of the ray / path queue (wavefront pool, paper queue;
+//                       0 for pixel-parallel)
+//   pixels_x_spp, triangles, threads   the size of the job and where it ran
+#include <string>
+
+#include "pathbench/common/settings.h"
+
+namespace pb::bench {
+
+struct RenderCase {
+  std::string scene;
+  RenderSettings settings;  // device, strategy, size, spp, bounces, sampling
+};
+
+std::string render_benchmark_name(const RenderCase& c);
+void register_render_benchmark(const RenderCase& c);
+
+}  // namespace pb::bench
