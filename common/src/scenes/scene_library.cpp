@@ -1,6 +1,7 @@
 #include <fmt/core.h>
 
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 
 #include "pathbench/common/errors.h"
@@ -36,12 +37,29 @@ std::vector<double> parse_params(const std::string& spec, const std::string& par
   return out;
 }
 
+// The one whole-number parameter of `spec` ("name:value"), in [lo, hi].
+int64_t integer_param(const std::string& spec, const std::string& base, const std::string& params, const char* what,
+                      int64_t lo, int64_t hi) {
+  if (params.empty())
+    throw InputError(fmt::format("scene '{}' needs a parameter: the {} from {} to {} (e.g. {}:{})", spec, what, lo,
+                                 hi, base, hi / 2));
+  const double v = parse_params(spec, params, 1).at(0);
+  if (v != std::floor(v))
+    throw InputError(fmt::format("scene '{}': the {} must be a whole number from {} to {}", spec, what, lo, hi));
+  if (!(v >= double(lo) && v <= double(hi)))
+    throw InputError(fmt::format("scene '{}': the {} {} is out of range ({} to {})", spec, what, params, lo, hi));
+  return int64_t(v);
+}
+
 }  // namespace
 
 const std::vector<BuiltinSceneInfo>& builtin_scenes() {
   static const std::vector<BuiltinSceneInfo> list = {
       {"paper-cornell", "the 2015 paper's 14-triangle Cornell box (../shared/paper-scene.md)"},
       {"furnace:A,LE", "white furnace: closed cube, every wall albedo A (default 0.5), emission LE (default 1)"},
+      {"cornell-box", "the Cornell box from Cornell University's published measurements (38 triangles)"},
+      {"paper-cornell-ico:L", "paper-cornell plus an icosphere of level L = 0..10 (20*4^L triangles; L=8: 1,310,720)"},
+      {"scaling:N", "paper-cornell plus a tessellated sphere: about N triangles in all (N = 10..10^7)"},
   };
   return list;
 }
@@ -57,7 +75,12 @@ Scene load_scene(const std::string& spec) {
   const size_t colon = spec.find(':');
   const std::string base = spec.substr(0, colon);
   const std::string params = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  if (base == "paper-cornell" && params.empty()) return make_paper_cornell();
+  if ((base == "paper-cornell" || base == "cornell-box") && colon != std::string::npos)
+    throw InputError(fmt::format("scene '{}': '{}' takes no parameters", spec, base));
+  if (base == "paper-cornell") return make_paper_cornell();
+  if (base == "cornell-box") return make_cornell_box();
+  if (base == "paper-cornell-ico") return make_paper_cornell_ico(int(integer_param(spec, base, params, "level", 0, 10)));
+  if (base == "scaling") return make_scaling(uint64_t(integer_param(spec, base, params, "triangle count", 10, 10000000)));
   if (base == "furnace") {
     auto p = parse_params(spec, params, 2);
     float a = p.size() > 0 ? float(p[0]) : 0.5f;

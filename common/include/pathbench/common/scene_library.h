@@ -1,5 +1,6 @@
 #pragma once
 // Where scenes come from: built-in names (with parameters after a colon) and files.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,15 @@ Scene load_scene(const std::string& name_or_path);
 Scene make_paper_cornell();
 // Closed cube, every wall albedo `albedo` and emission `emission` (white furnace).
 Scene make_furnace(float albedo, float emission);
+// The Cornell box from Cornell University's published data (millimetres; camera at
+// (278, 273, -800) looking along +z, 39.3 degree field of view).
+Scene make_cornell_box();
+// make_paper_cornell() plus an icosphere of subdivision `level` (0..10: 20 * 4^level
+// triangles), radius 5, centre (0, -4, -4), albedo 0.5.
+Scene make_paper_cornell_ico(int level);
+// make_paper_cornell() plus a tessellated sphere (radius 5, centre (0, -4, -4), albedo
+// 0.5): about `triangles` in all (the sphere takes the remainder; at least the box's 14).
+Scene make_scaling(uint64_t triangles);
 
 // Scene files (scene_file.cpp).
 Scene load_scene_json(const std::string& path);
