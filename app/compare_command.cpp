@@ -7,7 +7,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numeric>
+#include <regex>
 
 #include "pathbench/common/errors.h"
 
@@ -118,16 +120,23 @@ double unit_to_seconds(const std::string& unit, const std::string& path, const s
 
 }  // namespace
 
-BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
+nlohmann::json read_benchmark_json(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file", path));
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("{}: cannot be read", path));
-  nlohmann::json j;
+  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
+  // counter); strict JSON has no NaN, so such values are read as null.
+  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
   try {
-    j = nlohmann::json::parse(in);
+    return nlohmann::json::parse(std::regex_replace(raw, non_finite, "$1null"));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
   }
+}
+
+BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
+  const nlohmann::json j = read_benchmark_json(path);
   if (!j.is_object() || !j.contains("benchmarks") || !j["benchmarks"].is_array() || !j.contains("context"))
     throw InputError(fmt::format("{}: not Google Benchmark JSON (expected an object with 'context' and a "
                                  "'benchmarks' array; write it with --benchmark_out=FILE.json)",

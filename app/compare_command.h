@@ -4,6 +4,7 @@
 // repetition times plus a minimum effect size. Exit status: 0 no regression, 1 some
 // benchmark regressed, 2 bad input.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <map>
 #include <string>
@@ -48,6 +49,9 @@ struct BenchFile {
   std::map<std::string, BenchSeries> series;
   std::vector<std::string> order;
 };
+// The file as JSON, with Google Benchmark's bare NaN / inf values read as null.
+// Throws InputError when it is missing or not JSON.
+nlohmann::json read_benchmark_json(const std::string& path);
 // Throws InputError: missing or unreadable file, not Google Benchmark JSON, or a
 // benchmark with fewer than `min_repetitions` repetitions.
 BenchFile load_benchmark_json(const std::string& path, int min_repetitions);

@@ -2,29 +2,45 @@
 
 #include <fmt/core.h>
 
+#include <chrono>
 #include <vector>
 
+#include "device_render.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
-#include "render_command.h"
 
 namespace pb::app {
 
 namespace {
 
-// The paper's own figures (Tunnel 2015, Tesla K20m).
+// The paper's own figures (Tunnel 2015, Tesla K20m): 256x256, 800 spp, 2 bounces,
+// uniform hemisphere sampling, one global queue of 48-byte tasks.
 constexpr double kPaperSeconds = 27.0;
 constexpr double kPaperTaskBytes = 48.0;
-
-struct Row {
-  RunReport report;
-};
+constexpr uint32_t kPaperSpp = 800;
+constexpr uint32_t kSide = 256;
 
 std::string fmt_bytes(double b) {
+  if (b <= 0) return "0";
   if (b >= 1e9) return fmt::format("{:.2f} GB", b / 1e9);
   if (b >= 1e6) return fmt::format("{:.1f} MB", b / 1e6);
   return fmt::format("{:.0f} kB", b / 1e3);
+}
+
+double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
+
+uint64_t queue_bytes(const RunReport& r) {
+  for (const char* key : {"queue_bytes", "pool_bytes"})
+    if (r.extra.contains(key) && r.extra[key].is_number()) return r.extra[key].get<uint64_t>();
+  return 0;
+}
+
+std::string device_label(const RunReport& r) {
+  if (r.settings.device == Device::Cpu) return fmt::format("CPU, {} threads", r.threads);
+  if (r.extra.contains("gpu_name") && r.extra["gpu_name"].is_string())
+    return fmt::format("GPU ({})", r.extra["gpu_name"].get<std::string>());
+  return "GPU";
 }
 
 }  // namespace
@@ -33,6 +49,8 @@ void add_reproduce_options(CLI::App& cmd, ReproduceOptions& o) {
   cmd.add_option("--device", o.device, "cpu, gpu, or all (cpu, plus gpu when there is one)")->capture_default_str();
   cmd.add_option("--out-dir", o.out_dir, "where to write images, reports and the table (default results/<machine>)");
   cmd.add_option("--spp", o.spp, "samples per pixel (the paper: 800)")->capture_default_str();
+  cmd.add_option("--uniform-spp", o.uniform_spp,
+                 "samples per pixel for the uniform rows (0: --spp); their times are scaled to --spp in the table");
   cmd.add_option("--threads", o.threads, "CPU threads (0: all)")->capture_default_str();
   cmd.add_flag("--quiet", o.quiet, "no progress bars");
 }
@@ -41,6 +59,7 @@ int run_reproduce(const ReproduceOptions& o) {
   if (o.device != "cpu" && o.device != "gpu" && o.device != "all")
     throw InputError(fmt::format("--device: unknown device '{}' (expected cpu, gpu or all)", o.device));
   if (o.spp == 0) throw InputError("--spp: must be at least 1");
+  const uint32_t uniform_spp = o.uniform_spp ? o.uniform_spp : o.spp;
   std::vector<Device> devices;
   std::string why_no_gpu;
   const bool have_gpu = gpu_available(&why_no_gpu);
@@ -50,15 +69,17 @@ int run_reproduce(const ReproduceOptions& o) {
 
   const std::string dir = o.out_dir.empty() ? "results/" + machine_slug() : o.out_dir;
   const Scene scene = make_paper_cornell();
+  const auto t_start = std::chrono::steady_clock::now();
   std::vector<RunReport> rows;
   nlohmann::json all = nlohmann::json::array();
   for (Device dev : devices) {
     std::vector<Strategy> strategies = {Strategy::Pixel, Strategy::Wavefront};
+    if (dev == Device::Gpu) strategies.push_back(Strategy::PaperQueue);
     for (Sampling sampling : {Sampling::Uniform, Sampling::Nee}) {
       for (Strategy strategy : strategies) {
         RenderSettings s;
-        s.width = s.height = 256;
-        s.spp = o.spp;
+        s.width = s.height = kSide;
+        s.spp = sampling == Sampling::Uniform ? uniform_spp : o.spp;
         s.max_bounces = 2;
         s.sampling = sampling;
         s.strategy = strategy;
@@ -67,7 +88,20 @@ int run_reproduce(const ReproduceOptions& o) {
         s.progress = !o.quiet;
         Film film(s.width, s.height, false);
         RunReport r;
-        render_on_device(scene, s, film, r, false);
+        try {
+          render_on_device(scene, s, film, r, false);
+        } catch (const std::exception& e) {
+          // The paper's queue may not fit: a row saying so, not a failed run.
+          if (strategy != Strategy::PaperQueue) throw;
+          fmt::print(stderr, "reproduce: {} {} {}: {}\n", to_string(dev), to_string(strategy), to_string(sampling),
+                     e.what());
+          r.settings = s;
+          r.scene = scene.name;
+          r.extra["error"] = e.what();
+          all.push_back(r.to_json());
+          rows.push_back(r);
+          continue;
+        }
         // The paper's own image (uniform sampling) and ours with light sampling.
         if (strategy == Strategy::Pixel) {
           const std::string stem = fmt::format("{}/paper-cornell-{}-{}", dir, to_string(dev), to_string(sampling));
@@ -87,25 +121,56 @@ int run_reproduce(const ReproduceOptions& o) {
       }
     }
   }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   write_text_file(dir + "/paper-cornell-report.json", all.dump(2) + "\n");
 
   std::string md;
-  md += fmt::format("# The 2015 paper's experiment: paper-cornell, 256x256, {} spp, 2 bounces\n\n", o.spp);
-  md += "| device | strategy | sampling | time (s) | vs paper's 27 s | M rays/s | M samples/s | path state / path | peak host |\n";
-  md += "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
-  md += fmt::format("| Tesla K20m (paper) | global queue | uniform | {:.1f} | 1.0x | | {:.2f} | {:.0f} B | |\n", kPaperSeconds,
-                    256.0 * 256 * 800 / kPaperSeconds / 1e6, kPaperTaskBytes);
+  md += fmt::format("# The 2015 paper's experiment: paper-cornell, {}x{}, {} spp, 2 bounces\n\n", kSide, kSide, o.spp);
+  md += "| device | strategy | sampling | spp run | time (s) | time at " + std::to_string(o.spp) +
+        " spp (s) | vs paper's 27 s | M rays/s | M paths/s | path state / path | queue or pool | peak host | peak device |\n";
+  md += "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  md += fmt::format("| Tesla K20m (paper, 2015) | global queue | uniform | {} | {:.1f} | {:.1f} | 1.0x | | {:.2f} | {:.0f} B | "
+                    "{} (256x256x800 tasks x 48 B, computed) | | |\n",
+                    kPaperSpp, kPaperSeconds, kPaperSeconds * o.spp / kPaperSpp,
+                    double(kSide) * kSide * kPaperSpp / kPaperSeconds / 1e6, kPaperTaskBytes,
+                    fmt_bytes(double(kSide) * kSide * kPaperSpp * kPaperTaskBytes));
+  bool scaled = false;
   for (const RunReport& r : rows) {
-    double secs = r.settings.device == Device::Gpu ? r.device_seconds : r.seconds;
-    md += fmt::format("| {} | {} | {} | {:.3f} | {:.1f}x | {:.1f} | {:.2f} | {} B | {} |\n",
-                      r.settings.device == Device::Cpu ? fmt::format("CPU ({} threads)", r.threads) : std::string("GPU"),
-                      to_string(r.settings.strategy), to_string(r.settings.sampling), secs,
-                      kPaperSeconds / secs * (800.0 / r.settings.spp), r.rays_per_second() / 1e6,
-                      double(r.paths) / secs / 1e6, r.state_bytes_per_path, fmt_bytes(double(r.peak_host_bytes)));
+    if (r.extra.contains("error")) {
+      md += fmt::format("| {} | {} | {} | {} | failed: {} | | | | | | | | |\n", device_label(r), to_string(r.settings.strategy),
+                        to_string(r.settings.sampling), r.settings.spp, r.extra["error"].get<std::string>());
+      continue;
+    }
+    const double secs = render_seconds(r);
+    const double at_spp = secs * double(o.spp) / double(r.settings.spp);
+    const bool row_scaled = r.settings.spp != o.spp;
+    scaled |= row_scaled;
+    const double vs_paper = kPaperSeconds / (secs * double(kPaperSpp) / double(r.settings.spp));
+    md += fmt::format("| {} | {} | {} | {} | {:.2f} | {:.2f}{} | {:.1f}x | {:.1f} | {:.2f} | {} B | {} | {} | {} |\n",
+                      device_label(r), to_string(r.settings.strategy), to_string(r.settings.sampling), r.settings.spp,
+                      secs, at_spp, row_scaled ? " (scaled)" : "", vs_paper, r.rays_per_second() / 1e6,
+                      double(r.paths) / secs / 1e6, r.state_bytes_per_path,
+                      r.settings.strategy == Strategy::Pixel ? std::string("none") : fmt_bytes(double(queue_bytes(r))),
+                      fmt_bytes(double(r.peak_host_bytes)),
+                      r.settings.device == Device::Gpu ? fmt_bytes(double(r.peak_device_bytes)) : std::string("-"));
   }
-  md += fmt::format("\nCPU: {}. Paper's queue: 48 B/task; 512x512x300 needs {} (more than the K20m's 5 GB).\n",
-                    cpu_model(), fmt_bytes(512.0 * 512 * 300 * kPaperTaskBytes));
-  if (!have_gpu) md += fmt::format("GPU rows absent: {}.\n", why_no_gpu);
+  md += "\n";
+  md += "- Paper (Tunnel 2015): about 27 s on a Tesla K20m for 256x256 at 800 spp with two diffuse bounces and uniform "
+        "hemisphere sampling; every ray of the frame in one global queue of 48-byte tasks: 512x512x300 needed " +
+        fmt_bytes(512.0 * 512 * 300 * kPaperTaskBytes) + ".\n";
+  md += "- \"vs paper\" is the paper's 27 s divided by our time at 800 spp (higher is faster). Different hardware: a "
+        "comparison of the experiment, not of the chips.\n";
+  md += "- Times are render times: CPU wall clock around the render (after the Embree build); GPU time from CUDA "
+        "events. M paths/s = samples per second.\n";
+  md += "- \"queue or pool\": bytes of path state held at once (CPU/GPU wavefront: the bounded pool of paths in flight; "
+        "paper-queue: the whole frame's queue); pixel-parallel keeps one path per thread.\n";
+  if (scaled)
+    md += fmt::format("- Rows marked (scaled) ran at fewer spp to keep `pathbench reproduce` short; their time at {} spp "
+                      "is the measured time x {} / spp run (render time is linear in spp).\n",
+                      o.spp, o.spp);
+  md += fmt::format("- CPU: {} ({} hardware threads). Git revision {}. Whole run: {:.1f} s wall.\n", cpu_model(),
+                    hardware_threads(), git_revision(), wall);
+  if (!have_gpu) md += fmt::format("- GPU rows absent: {}.\n", why_no_gpu);
   write_text_file(dir + "/paper-cornell.md", md);
   fmt::print("\n{}\nwritten: {}/paper-cornell.md, paper-cornell-report.json, images\n", md, dir);
   return 0;

@@ -1,8 +1,12 @@
 #pragma once
-// `pathbench reproduce`: the 2015 paper's experiment, on the CPU and (where there is
-// one) the GPU, printed beside the paper's own figures.
+// `pathbench reproduce`: the 2015 paper's experiment (paper-cornell, 256x256, 800 spp,
+// 2 bounces; uniform sampling as the paper did, and light sampling) on the CPU and,
+// where there is one, the GPU, every strategy, printed beside the paper's own figures.
+// Writes results/<machine>/paper-cornell.md (the table), paper-cornell-report.json
+// (one RunReport per row), paper-cornell.png / .exr and per-device images.
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <string>
 
 namespace pb::app {
@@ -11,6 +15,7 @@ struct ReproduceOptions {
   std::string device = "all";   // cpu, gpu or all (= cpu, plus gpu when present)
   std::string out_dir;          // default results/<machine>
   uint32_t spp = 800;
+  uint32_t uniform_spp = 0;     // spp of the uniform rows; 0 = spp (times are scaled to spp in the table)
   int threads = 0;
   bool quiet = false;
 };

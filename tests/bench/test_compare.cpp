@@ -1,0 +1,140 @@
+// `pathbench compare`: the Mann-Whitney U test against SciPy's values, verdicts on the
+// committed fixtures (tests/data/bench/), exit statuses of the command line.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+#include "compare_command.h"
+#include "pathbench/common/errors.h"
+
+namespace {
+
+using pb::app::CompareOptions;
+using pb::app::mann_whitney_u;
+using pb::app::run_compare;
+
+const std::string kData = std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/bench/";
+
+int compare(const std::string& base, const std::string& next, double threshold = 0.05, double alpha = 0.05) {
+  CompareOptions o;
+  o.base = base;
+  o.next = next;
+  o.threshold = threshold;
+  o.alpha = alpha;
+  return run_compare(o);
+}
+
+// A copy of `in` with every iteration's time (and rays/s inversely) scaled by `f`.
+std::string scaled_copy(const std::string& in, double f, const std::string& name) {
+  nlohmann::json j = pb::app::read_benchmark_json(in);
+  for (auto& b : j["benchmarks"]) {
+    for (const char* k : {"real_time", "cpu_time"})
+      if (b.contains(k)) b[k] = b[k].get<double>() * f;
+    if (b.contains("rays_per_second")) b["rays_per_second"] = b["rays_per_second"].get<double>() / f;
+  }
+  const std::string out = std::string(PATHBENCH_TEST_TMP) + "/" + name;
+  std::ofstream(out) << j.dump(1);
+  return out;
+}
+
+int cli(const std::string& args) {
+  const std::string cmd = std::string(PATHBENCH_CLI) + " compare " + args + " > /dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+TEST(MannWhitney, ExactMatchesScipy) {
+  // scipy.stats.mannwhitneyu(a, b, alternative='two-sided', method='exact')
+  std::vector<double> a{1, 2, 3, 4, 5, 6, 7, 8, 9}, b{10, 11, 12, 13, 14, 15, 16, 17, 18};
+  auto r = mann_whitney_u(a, b);
+  EXPECT_TRUE(r.exact);
+  EXPECT_DOUBLE_EQ(r.u_a, 0.0);
+  EXPECT_NEAR(r.p, 4.113533525298231e-05, 1e-12);
+
+  std::vector<double> c{2.5, 3.5, 4.5, 5.5, 6.5, 7.5, 8.5, 9.5, 10.5};
+  std::vector<double> d{1, 2, 3, 4, 5, 6, 7, 8, 9};
+  r = mann_whitney_u(c, d);
+  EXPECT_DOUBLE_EQ(r.u_a, 53.0);
+  EXPECT_NEAR(r.p, 0.29732620320855613, 1e-12);
+}
+
+TEST(MannWhitney, TiesUseNormalApproximationLikeScipy) {
+  // scipy: method='asymptotic', use_continuity=True -> U = 13, p = 0.015934147250231023
+  std::vector<double> a{1, 2, 2, 3, 3, 3, 4, 5, 6}, b{3, 4, 4, 5, 5, 6, 7, 7, 8};
+  auto r = mann_whitney_u(a, b);
+  EXPECT_FALSE(r.exact);
+  EXPECT_DOUBLE_EQ(r.u_a, 13.0);
+  EXPECT_NEAR(r.p, 0.015934147250231023, 1e-12);
+}
+
+TEST(MannWhitney, AllEqualGivesPOne) {
+  std::vector<double> a(9, 1.0);
+  EXPECT_DOUBLE_EQ(mann_whitney_u(a, a).p, 1.0);
+}
+
+TEST(Compare, IdenticalIsNotARegression) {
+  EXPECT_EQ(compare(kData + "base.json", kData + "identical.json"), 0);
+  EXPECT_EQ(compare(kData + "base.json", kData + "base.json"), 0);
+}
+
+TEST(Compare, TenPercentSlowerIsARegression) {
+  EXPECT_EQ(compare(kData + "base.json", kData + "slower10.json"), 1);
+  // The other way round it is an improvement, not a regression.
+  EXPECT_EQ(compare(kData + "slower10.json", kData + "base.json"), 0);
+  // A 10% slowdown below a 15% threshold is not one either.
+  EXPECT_EQ(compare(kData + "base.json", kData + "slower10.json", 0.15), 0);
+}
+
+TEST(Compare, NoisyButEqualIsNotARegression) {
+  EXPECT_EQ(compare(kData + "noisy-a.json", kData + "noisy-b.json"), 0);
+  EXPECT_EQ(compare(kData + "noisy-b.json", kData + "noisy-a.json"), 0);
+}
+
+TEST(Compare, VerdictsPerBenchmark) {
+  auto base = pb::app::load_benchmark_json(kData + "base.json", 9);
+  auto slow = pb::app::load_benchmark_json(kData + "slower10.json", 9);
+  auto rows = pb::app::compare_files(base, slow, 0.05, 0.05);
+  ASSERT_EQ(rows.size(), 3u);
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.verdict, pb::app::Verdict::Regressed) << r.name;
+    EXPECT_NEAR(r.time_change, 0.10, 1e-9) << r.name;
+    EXPECT_TRUE(r.has_rays);
+    EXPECT_NEAR(r.rays_change, 1 / 1.1 - 1, 1e-9) << r.name;
+  }
+}
+
+TEST(Compare, BadInputIsAnInputError) {
+  EXPECT_THROW(compare(kData + "does-not-exist.json", kData + "base.json"), pb::InputError);
+  EXPECT_THROW(compare(kData + "base.json", kData + "not-benchmark.json"), pb::InputError);
+  EXPECT_THROW(compare(kData + "base.json", kData + "too-few-repetitions.json"), pb::InputError);
+  EXPECT_THROW(compare(kData + "aggregates-only.json", kData + "base.json"), pb::InputError);
+  EXPECT_THROW(compare(kData + "make_fixtures.py", kData + "base.json"), pb::InputError);
+  try {
+    compare(kData + "base.json", kData + "too-few-repetitions.json");
+  } catch (const pb::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("at least 9"), std::string::npos) << e.what();
+  }
+}
+
+// The acceptance check on a real 9-repetition quick run of this machine.
+TEST(Compare, RealQuickRun) {
+  const std::string real = kData + "quick-9rep.json";
+  EXPECT_EQ(compare(real, real), 0);
+  EXPECT_EQ(compare(real, scaled_copy(real, 1.1, "quick-9rep-x1.1.json")), 1);
+}
+
+TEST(CompareCli, ExitStatuses) {
+  EXPECT_EQ(cli(kData + "base.json " + kData + "identical.json"), 0);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "slower10.json"), 1);
+  EXPECT_EQ(cli(kData + "noisy-a.json " + kData + "noisy-b.json --threshold 0.05 --alpha 0.05"), 0);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "missing.json"), 2);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "not-benchmark.json"), 2);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "too-few-repetitions.json"), 2);
+  EXPECT_EQ(cli(kData + "base.json"), 2);  // NEW missing
+}
+
+}  // namespace
