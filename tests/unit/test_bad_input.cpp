@@ -5,8 +5,9 @@
 
 #include <cmath>
 #include <functional>
-#include <initializer_list>
 #include <limits>
+#include <ostream>
+#include <vector>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
@@ -18,7 +19,7 @@ namespace {
 const std::string kData = std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/scenes/";
 
 // Runs `f`, expects an InputError whose message contains every one of `parts`.
-void expect_input_error(const std::function<void()>& f, std::initializer_list<std::string> parts) {
+void expect_input_error(const std::function<void()>& f, const std::vector<std::string>& parts) {
   try {
     f();
   } catch (const InputError& e) {
@@ -31,68 +32,69 @@ void expect_input_error(const std::function<void()>& f, std::initializer_list<st
   }
   ADD_FAILURE() << "expected InputError, nothing was thrown";
 }
-void expect_scene_error(const std::string& spec, std::initializer_list<std::string> parts) {
+void expect_scene_error(const std::string& spec, const std::vector<std::string>& parts) {
   expect_input_error([&] { load_scene(spec); }, parts);
 }
 
-// Scene files.
-TEST(BadSceneFile, MissingFile) { expect_scene_error(kData + "no-such-scene.json", {"no-such-scene.json", "no such file"}); }
-TEST(BadSceneFile, MissingObjFile) { expect_scene_error(kData + "no-such-mesh.obj", {"no-such-mesh.obj", "no such file"}); }
-TEST(BadSceneFile, TruncatedJson) {
-  expect_scene_error(kData + "truncated.json", {"truncated.json", "malformed JSON", "unexpected end of input"});
-}
-TEST(BadSceneFile, MalformedJson) { expect_scene_error(kData + "malformed.json", {"malformed.json", "malformed JSON", "line 1"}); }
-TEST(BadSceneFile, MalformedObj) { expect_scene_error(kData + "malformed.obj", {"malformed.obj:3:", "'one' is not a number"}); }
-TEST(BadSceneFile, JsonWrongType) {
-  expect_scene_error(kData + "wrong-type.json", {"wrong-type.json", "camera.position", "expected an array of 3 numbers"});
-}
-TEST(BadSceneFile, JsonMissingField) {
-  expect_scene_error(kData + "missing-field.json", {"missing-field.json", "camera.look_at", "missing"});
-}
-TEST(BadSceneFile, JsonInfiniteCoordinate) {
-  expect_scene_error(kData + "nan.json", {"nan.json", "triangles[0].vertices[1][0]", "not a finite number"});
-}
-TEST(BadSceneFile, JsonNumberOverflow) {
-  expect_scene_error(kData + "overflow.json", {"overflow.json", "malformed JSON", "number overflow parsing '1e999'"});
-}
-TEST(BadSceneFile, ObjNanCoordinate) { expect_scene_error(kData + "nan.obj", {"nan.obj:2:", "NaN or infinite"}); }
-TEST(BadSceneFile, JsonVertexIndexOutOfRange) {
-  expect_scene_error(kData + "bad-index.json", {"bad-index.json", "triangles[0].indices[1][2]", "vertex index 5 is out of range"});
-}
-TEST(BadSceneFile, ObjVertexIndexOutOfRange) {
-  expect_scene_error(kData + "bad-index.obj", {"bad-index.obj:4:", "vertex 7", "only 3 vertices"});
-}
-TEST(BadSceneFile, JsonUnknownMaterial) {
-  expect_scene_error(kData + "unknown-material.json", {"unknown-material.json", "triangles[0].material", "unknown material 'blue'"});
-}
-TEST(BadSceneFile, ObjUnknownMaterial) {
-  expect_scene_error(kData + "unknown-material.obj", {"unknown-material.obj:5:", "usemtl 'nosuch'"});
-}
-TEST(BadSceneFile, ObjMissingMaterialLibrary) {
-  expect_scene_error(kData + "missing-mtl.obj", {"missing-mtl.obj:1:", "no-such.mtl", "not found"});
-}
-TEST(BadSceneFile, JsonMissingMeshFile) {
-  expect_scene_error(kData + "missing-mesh.json", {"missing-mesh.json", "meshes[0].file", "no-such-mesh.obj", "no such file"});
-}
-TEST(BadSceneFile, OnlyZeroAreaTriangles) {
-  testing::internal::CaptureStderr();
-  expect_scene_error(kData + "all-zero-area.json", {"all-zero-area.json", "every triangle has zero area"});
+// Scene files (fixtures named after their one problem) and built-in names: load_scene
+// must throw an InputError whose message has every one of `parts`.
+struct BadScene {
+  const char* test;
+  std::string spec;  // a file under tests/data/scenes/ (kData + name), or a built-in spec
+  std::vector<std::string> parts;
+};
+std::ostream& operator<<(std::ostream& os, const BadScene& c) { return os << c.spec; }
+
+class BadSceneSpec : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(BadSceneSpec, IsOneInputErrorSayingWhatIsWrong) {
+  const BadScene& c = GetParam();
+  testing::internal::CaptureStderr();  // e.g. the zero-area warning before the error
+  expect_scene_error(c.spec, c.parts);
   testing::internal::GetCapturedStderr();
 }
-TEST(BadSceneFile, UnknownFileType) { expect_scene_error(kData + "README.md", {"README.md", "unknown scene file type"}); }
 
-// Built-in scene names and parameters.
-TEST(BadSceneName, UnknownName) { expect_scene_error("cornell-bx", {"unknown scene 'cornell-bx'", "cornell-box"}); }
-TEST(BadSceneName, IcoLevelNotANumber) { expect_scene_error("paper-cornell-ico:x", {"paper-cornell-ico:x", "'x' is not a number"}); }
-TEST(BadSceneName, IcoLevelOutOfRange) { expect_scene_error("paper-cornell-ico:99", {"paper-cornell-ico:99", "out of range", "0 to 10"}); }
-TEST(BadSceneName, IcoLevelNegative) { expect_scene_error("paper-cornell-ico:-1", {"out of range"}); }
-TEST(BadSceneName, IcoLevelNotWhole) { expect_scene_error("paper-cornell-ico:1.5", {"whole number"}); }
-TEST(BadSceneName, IcoLevelMissing) { expect_scene_error("paper-cornell-ico", {"needs a parameter", "level"}); }
-TEST(BadSceneName, IcoTooManyParameters) { expect_scene_error("paper-cornell-ico:1,2", {"at most 1 parameter"}); }
-TEST(BadSceneName, ScalingTooFew) { expect_scene_error("scaling:5", {"scaling:5", "out of range", "10 to 10000000"}); }
-TEST(BadSceneName, ScalingTooMany) { expect_scene_error("scaling:2e7", {"out of range"}); }
-TEST(BadSceneName, ScalingNotANumber) { expect_scene_error("scaling:many", {"'many' is not a number"}); }
-TEST(BadSceneName, ParameterToAFixedScene) { expect_scene_error("cornell-box:2", {"cornell-box", "takes no parameters"}); }
+INSTANTIATE_TEST_SUITE_P(
+    Files, BadSceneSpec,
+    ::testing::Values(
+        BadScene{"MissingFile", kData + "no-such-scene.json", {"no-such-scene.json", "no such file"}},
+        BadScene{"MissingObjFile", kData + "no-such-mesh.obj", {"no-such-mesh.obj", "no such file"}},
+        BadScene{"TruncatedJson", kData + "truncated.json", {"truncated.json", "malformed JSON", "unexpected end of input"}},
+        BadScene{"MalformedJson", kData + "malformed.json", {"malformed.json", "malformed JSON", "line 1"}},
+        BadScene{"MalformedObj", kData + "malformed.obj", {"malformed.obj:3:", "'one' is not a number"}},
+        BadScene{"JsonWrongType", kData + "wrong-type.json", {"wrong-type.json", "camera.position", "expected an array of 3 numbers"}},
+        BadScene{"JsonMissingField", kData + "missing-field.json", {"missing-field.json", "camera.look_at", "missing"}},
+        BadScene{"JsonInfiniteCoordinate", kData + "nan.json", {"nan.json", "triangles[0].vertices[1][0]", "not a finite number"}},
+        BadScene{"JsonNumberOverflow", kData + "overflow.json", {"overflow.json", "malformed JSON", "number overflow parsing '1e999'"}},
+        BadScene{"ObjNanCoordinate", kData + "nan.obj", {"nan.obj:2:", "NaN or infinite"}},
+        BadScene{"JsonVertexIndexOutOfRange", kData + "bad-index.json",
+                 {"bad-index.json", "triangles[0].indices[1][2]", "vertex index 5 is out of range"}},
+        BadScene{"ObjVertexIndexOutOfRange", kData + "bad-index.obj", {"bad-index.obj:4:", "vertex 7", "only 3 vertices"}},
+        BadScene{"JsonUnknownMaterial", kData + "unknown-material.json",
+                 {"unknown-material.json", "triangles[0].material", "unknown material 'blue'"}},
+        BadScene{"ObjUnknownMaterial", kData + "unknown-material.obj", {"unknown-material.obj:5:", "usemtl 'nosuch'"}},
+        BadScene{"ObjMissingMaterialLibrary", kData + "missing-mtl.obj", {"missing-mtl.obj:1:", "no-such.mtl", "not found"}},
+        BadScene{"JsonMissingMeshFile", kData + "missing-mesh.json",
+                 {"missing-mesh.json", "meshes[0].file", "no-such-mesh.obj", "no such file"}},
+        BadScene{"OnlyZeroAreaTriangles", kData + "all-zero-area.json", {"all-zero-area.json", "every triangle has zero area"}},
+        BadScene{"UnknownFileType", kData + "README.md", {"README.md", "unknown scene file type"}}),
+    [](const auto& info) { return std::string(info.param.test); });
+
+INSTANTIATE_TEST_SUITE_P(
+    BuiltinNames, BadSceneSpec,
+    ::testing::Values(
+        BadScene{"UnknownName", "cornell-bx", {"unknown scene 'cornell-bx'", "cornell-box"}},
+        BadScene{"IcoLevelNotANumber", "paper-cornell-ico:x", {"paper-cornell-ico:x", "'x' is not a number"}},
+        BadScene{"IcoLevelOutOfRange", "paper-cornell-ico:99", {"paper-cornell-ico:99", "out of range", "0 to 10"}},
+        BadScene{"IcoLevelNegative", "paper-cornell-ico:-1", {"out of range"}},
+        BadScene{"IcoLevelNotWhole", "paper-cornell-ico:1.5", {"whole number"}},
+        BadScene{"IcoTooManyParameters", "paper-cornell-ico:1,2", {"at most 1 parameter"}},
+        BadScene{"IcoLevelMissing", "paper-cornell-ico", {"needs a parameter", "level"}},
+        BadScene{"ScalingTooFew", "scaling:5", {"scaling:5", "out of range", "10 to 10000000"}},
+        BadScene{"ScalingTooMany", "scaling:2e7", {"out of range"}},
+        BadScene{"ScalingNotANumber", "scaling:many", {"'many' is not a number"}},
+        BadScene{"ParameterToAFixedScene", "cornell-box:2", {"cornell-box", "takes no parameters"}}),
+    [](const auto& info) { return std::string(info.param.test); });
 
 // Scenes built in code: finalize() checks what the loaders cannot express.
 Scene one_triangle() {
