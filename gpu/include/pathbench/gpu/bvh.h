@@ -1,0 +1,184 @@
+#pragma once
+// The GPU's BVH: a binary BVH built on the host by Embree's BVH builder
+// (gpu/src/bvh_build.cpp), flattened into 64-byte nodes that hold both children's
+// boxes (Aila & Laine 2009), and 48-byte triangles stored in leaf order. The traversal
+// below is host+device code: the GPU kernels and the host-side tests that check it
+// against Embree run the same function.
+#include <cstdint>
+
+#include "pathbench/common/hd.h"
+#include "pathbench/common/math.h"
+#include "pathbench/gpu/watertight.h"
+
+namespace pb::gpu {
+
+// Child reference: an inner node's index, or a leaf (top bit set) holding up to
+// kMaxLeafPrims consecutive triangles from `first`.
+constexpr uint32_t kLeafBit = 0x80000000u;
+constexpr uint32_t kMaxLeafPrims = 16;
+constexpr uint32_t kLeafFirstMask = (1u << 27) - 1;  // up to 134M triangle references
+PB_HD bool is_leaf(uint32_t ref) { return (ref & kLeafBit) != 0; }
+PB_HD uint32_t leaf_first(uint32_t ref) { return ref & kLeafFirstMask; }
+PB_HD uint32_t leaf_count(uint32_t ref) { return ((ref >> 27) & 15u) + 1; }
+PB_HD uint32_t make_leaf_ref(uint32_t first, uint32_t count) { return kLeafBit | ((count - 1) << 27) | first; }
+
+// Two children's boxes, laid out for three 16-byte loads, and their references.
+struct alignas(16) BvhNode {
+  float x[4];  // c0.lo.x, c0.hi.x, c1.lo.x, c1.hi.x
+  float y[4];
+  float z[4];
+  uint32_t child[2];
+  uint32_t pad[2];
+};
+static_assert(sizeof(BvhNode) == 64, "BvhNode is one 64-byte line");
+
+// A triangle's vertices in leaf order; v0's fourth word is the scene's triangle id.
+struct alignas(16) BvhTriangle {
+  float v0[3];
+  uint32_t prim;
+  float v1[3];
+  float pad1;
+  float v2[3];
+  float pad2;
+};
+static_assert(sizeof(BvhTriangle) == 48, "BvhTriangle is 48 bytes");
+
+// What the traversal reads: host or device pointers.
+struct BvhView {
+  const BvhNode* nodes;      // node 0 is the root, always an inner node
+  const BvhTriangle* tris;
+  uint32_t num_nodes;
+  uint32_t num_tris;
+};
+
+constexpr uint32_t kNoHit = 0xFFFFFFFFu;
+constexpr int kTraversalStackSize = 64;  // the builder limits the depth to fit
+
+struct TraversalStats {
+  uint32_t nodes = 0, tris = 0;
+};
+
+namespace detail {
+
+PB_HD float fmadd(float a, float b, float c) {
+#if defined(__CUDA_ARCH__)
+  return __fmaf_rn(a, b, c);  // explicit: the library is built with --fmad=false
+#else
+  return a * b + c;
+#endif
+}
+
+PB_HD void load_node(const BvhNode* nodes, uint32_t i, float (&x)[4], float (&y)[4], float (&z)[4],
+                     uint32_t (&child)[2]) {
+#if defined(__CUDA_ARCH__)
+  const float4* p = reinterpret_cast<const float4*>(nodes + i);
+  const float4 a = __ldg(p), b = __ldg(p + 1), c = __ldg(p + 2);
+  const uint4 d = __ldg(reinterpret_cast<const uint4*>(p + 3));
+  x[0] = a.x; x[1] = a.y; x[2] = a.z; x[3] = a.w;
+  y[0] = b.x; y[1] = b.y; y[2] = b.z; y[3] = b.w;
+  z[0] = c.x; z[1] = c.y; z[2] = c.z; z[3] = c.w;
+  child[0] = d.x; child[1] = d.y;
+#else
+  const BvhNode& n = nodes[i];
+  for (int k = 0; k < 4; ++k) { x[k] = n.x[k]; y[k] = n.y[k]; z[k] = n.z[k]; }
+  child[0] = n.child[0]; child[1] = n.child[1];
+#endif
+}
+
+PB_HD void load_triangle(const BvhTriangle* tris, uint32_t i, Vec3f& a, Vec3f& b, Vec3f& c, uint32_t& prim) {
+#if defined(__CUDA_ARCH__)
+  const float4* p = reinterpret_cast<const float4*>(tris + i);
+  const float4 p0 = __ldg(p), p1 = __ldg(p + 1), p2 = __ldg(p + 2);
+  a = {p0.x, p0.y, p0.z};
+  prim = __float_as_uint(p0.w);
+  b = {p1.x, p1.y, p1.z};
+  c = {p2.x, p2.y, p2.z};
+#else
+  const BvhTriangle& t = tris[i];
+  a = {t.v0[0], t.v0[1], t.v0[2]};
+  b = {t.v1[0], t.v1[1], t.v1[2]};
+  c = {t.v2[0], t.v2[1], t.v2[2]};
+  prim = t.prim;
+#endif
+}
+
+PB_HD float safe_inverse(float d) {
+  constexpr float kTiny = 1e-30f;  // keeps 1/d finite, so no 0 * inf = NaN in the slabs
+  return 1.0f / (std::fabs(d) > kTiny ? d : (d >= 0.0f ? kTiny : -kTiny));
+}
+
+}  // namespace detail
+
+// Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
+// own direction (need not be unit length). Returns the scene triangle id, or kNoHit;
+// t_hit receives the distance of a hit.
+template <bool kAnyHit>
+PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
+                        TraversalStats* stats = nullptr) {
+  const WatertightRay wr = make_watertight_ray(o, d);
+  const Vec3f inv = {detail::safe_inverse(d.x), detail::safe_inverse(d.y), detail::safe_inverse(d.z)};
+  const Vec3f oi = {-(o.x * inv.x), -(o.y * inv.y), -(o.z * inv.z)};
+  // Slab distances carry a few roundings: widen the far end (Ize 2013, 1 + 2 gamma(3));
+  // the builder also pads every box by a few ulps of the scene's scale.
+  constexpr float kFarScale = 1.0000004f;
+  uint32_t stack[kTraversalStackSize];
+  int sp = 0;
+  uint32_t ref = 0;
+  uint32_t hit = kNoHit;
+  float t = t_max;
+  for (;;) {
+    while (!is_leaf(ref)) {
+      float x[4], y[4], z[4];
+      uint32_t child[2];
+      detail::load_node(bvh.nodes, ref, x, y, z, child);
+      if (stats) ++stats->nodes;
+      float tn[2], tf[2];
+      for (int c = 0; c < 2; ++c) {
+        const float tx0 = detail::fmadd(x[2 * c], inv.x, oi.x), tx1 = detail::fmadd(x[2 * c + 1], inv.x, oi.x);
+        const float ty0 = detail::fmadd(y[2 * c], inv.y, oi.y), ty1 = detail::fmadd(y[2 * c + 1], inv.y, oi.y);
+        const float tz0 = detail::fmadd(z[2 * c], inv.z, oi.z), tz1 = detail::fmadd(z[2 * c + 1], inv.z, oi.z);
+        tn[c] = pmax(pmax(pmin(tx0, tx1), pmin(ty0, ty1)), pmax(pmin(tz0, tz1), 0.0f));
+        tf[c] = pmin(pmin(pmax(tx0, tx1), pmax(ty0, ty1)), pmax(tz0, tz1)) * kFarScale;
+        tf[c] = pmin(tf[c], t);
+      }
+      const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
+      if (h0 && h1) {
+        const bool swap = tn[1] < tn[0];
+        ref = swap ? child[1] : child[0];
+        stack[sp++] = swap ? child[0] : child[1];
+      } else if (h0 || h1) {
+        ref = h0 ? child[0] : child[1];
+      } else {
+        if (sp == 0) { t_hit = t; return hit; }
+        ref = stack[--sp];
+      }
+    }
+    const uint32_t first = leaf_first(ref), count = leaf_count(ref);
+    for (uint32_t i = first; i < first + count; ++i) {
+      Vec3f a, b, c;
+      uint32_t prim;
+      detail::load_triangle(bvh.tris, i, a, b, c, prim);
+      if (stats) ++stats->tris;
+      float tt;
+      if (intersect_watertight(wr, a, b, c, t, tt)) {
+        t = tt;
+        hit = prim;
+        if (kAnyHit) { t_hit = t; return hit; }
+      }
+    }
+    if (sp == 0) break;
+    ref = stack[--sp];
+  }
+  t_hit = t;
+  return hit;
+}
+
+PB_HD uint32_t intersect_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
+  return traverse<false>(bvh, o, d, t_max, t_hit);
+}
+PB_HD bool occluded(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
+  float t;
+  return traverse<true>(bvh, o, d, t_max, t) != kNoHit;
+}
+
+}  // namespace pb::gpu

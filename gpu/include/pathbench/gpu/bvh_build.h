@@ -1,0 +1,36 @@
+#pragma once
+// Host side of the GPU BVH: built with Embree's BVH builder (rtcNewBVH / rtcBuildBVH,
+// binned SAH, pathbench's own node type), then flattened into BvhNode / BvhTriangle
+// arrays ready to upload. Plain C++: the host-side traversal tests use it without CUDA.
+#include <cstdint>
+#include <vector>
+
+#include "pathbench/common/scene.h"
+#include "pathbench/gpu/bvh.h"
+
+namespace pb::gpu {
+
+struct BvhBuildOptions {
+  unsigned max_leaf_size = 4;     // <= kMaxLeafPrims
+  float traversal_cost = 1.0f;    // SAH cost of visiting a node, relative to...
+  float intersection_cost = 1.0f; // ...testing one triangle
+  bool high_quality = false;      // Embree's HIGH quality (spatial splits)
+};
+
+struct BvhHost {
+  std::vector<BvhNode> nodes;
+  std::vector<BvhTriangle> tris;
+  uint32_t depth = 0;       // longest root-to-leaf path, in inner nodes
+  uint32_t leaves = 0;
+  double sah_cost = 0;      // expected cost of a random ray, in the options' units
+  double build_seconds = 0;
+
+  BvhView view() const {
+    return {nodes.data(), tris.data(), uint32_t(nodes.size()), uint32_t(tris.size())};
+  }
+  uint64_t bytes() const { return nodes.size() * sizeof(BvhNode) + tris.size() * sizeof(BvhTriangle); }
+};
+
+BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options = {});
+
+}  // namespace pb::gpu

@@ -1,0 +1,75 @@
+#pragma once
+// The CUDA tracer. Three strategies, all driven by the shared path step of common/:
+//   pixel       megakernel, one thread per pixel sample, bounces looped in registers;
+//   wavefront   a bounded pool of paths in flight (structure of arrays in device
+//               memory), one kernel per stage linked by queues, refilled until done;
+//   paper-queue the 2015 paper's design done correctly: every path of the frame
+//               queued up front, then resolved stage by stage; refuses (InputError)
+//               when that queue does not fit in device memory.
+// Plain C++ header: the app includes it without nvcc.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pathbench/common/film.h"
+#include "pathbench/common/report.h"
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+
+namespace pb::gpu {
+
+// True when a CUDA device can be used; otherwise false and *why_not says why.
+bool device_available(std::string* why_not = nullptr);
+
+struct DeviceInfo {
+  std::string name;
+  int device = 0;
+  int compute_major = 0, compute_minor = 0;
+  int multiprocessors = 0;
+  uint64_t total_memory = 0;
+  int driver_version = 0;   // e.g. 13000
+  int runtime_version = 0;
+  std::string slug;         // results/<slug>/: "nvidia-h100-80gb-hbm3"
+};
+// Throws InputError when there is no device.
+DeviceInfo device_info();
+
+// The scene on the device: arrays and BVH, uploaded once, reusable for many renders.
+class GpuScene {
+ public:
+  explicit GpuScene(const Scene& scene);
+  ~GpuScene();
+  GpuScene(const GpuScene&) = delete;
+  GpuScene& operator=(const GpuScene&) = delete;
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// Renders into `film` (its size must match the settings); fills `report`. `profile`
+// prints a per-stage table (name, launches, total ms, share) to stdout and adds it to
+// report.extra["profile"]. Throws InputError for no device, settings the GPU cannot
+// run, or device memory too small for the request (naming the setting to lower).
+void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile = false);
+void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
+            RunReport& report, bool profile = false);
+
+// Default pool size of the wavefront strategy on this device.
+uint64_t default_paths_in_flight();
+
+// Traversal on the device, for tests: closest hit (or any hit when `any_hit`) for each
+// ray with 0 < t < t_max.
+struct TraceQuery {
+  Vec3f o, d;
+  float t_max;
+};
+struct TraceResult {
+  uint32_t prim;  // scene triangle id or 0xFFFFFFFF
+  float t;
+};
+std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit);
+
+}  // namespace pb::gpu

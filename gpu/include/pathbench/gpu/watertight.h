@@ -1,0 +1,83 @@
+#pragma once
+// Watertight ray/triangle intersection (Woop, Benthin, Wald, "Watertight Ray/Triangle
+// Intersection", JCGT 2013), host+device. The ray is sheared so that it runs along +z
+// from the origin; the 2D edge functions U, V, W of the sheared triangle then decide
+// the hit. Edge functions that come out exactly 0 are recomputed in double, so a ray
+// through a shared edge or vertex hits at least one of the triangles that meet there,
+// on the CPU and the GPU alike.
+//
+// Only IEEE +, -, *, / are used (no fused multiply-add: the GPU library is compiled
+// with --fmad=false), so the host and the device compute bit-identical results.
+#include <cstdint>
+
+#include "pathbench/common/hd.h"
+#include "pathbench/common/math.h"
+
+namespace pb::gpu {
+
+// Per-ray constants of the shear transform.
+struct WatertightRay {
+  Vec3f o;
+  int kx, ky, kz;
+  float sx, sy, sz;
+};
+
+PB_HD float wt_axis(const Vec3f& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+
+PB_HD WatertightRay make_watertight_ray(const Vec3f& o, const Vec3f& d) {
+  WatertightRay r;
+  r.o = o;
+  const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+  int kz = 2;
+  if (ax > ay && ax > az) kz = 0;
+  else if (ay > az) kz = 1;
+  int kx = kz + 1 == 3 ? 0 : kz + 1;
+  int ky = kx + 1 == 3 ? 0 : kx + 1;
+  const float dz = wt_axis(d, kz);
+  if (dz < 0.0f) {  // keep the winding: swap kx and ky
+    const int t = kx;
+    kx = ky;
+    ky = t;
+  }
+  r.kx = kx;
+  r.ky = ky;
+  r.kz = kz;
+  r.sx = wt_axis(d, kx) / dz;
+  r.sy = wt_axis(d, ky) / dz;
+  r.sz = 1.0f / dz;
+  return r;
+}
+
+// Tests the triangle (a, b, c) for a hit with 0 < t < t_max (t along the ray's own,
+// unnormalised direction). On a hit returns true and sets t.
+PB_HD bool intersect_watertight(const WatertightRay& r, const Vec3f& a, const Vec3f& b, const Vec3f& c,
+                                float t_max, float& t) {
+  const Vec3f A = a - r.o, B = b - r.o, C = c - r.o;
+  const float Az = wt_axis(A, r.kz), Bz = wt_axis(B, r.kz), Cz = wt_axis(C, r.kz);
+  const float Ax = wt_axis(A, r.kx) - r.sx * Az, Ay = wt_axis(A, r.ky) - r.sy * Az;
+  const float Bx = wt_axis(B, r.kx) - r.sx * Bz, By = wt_axis(B, r.ky) - r.sy * Bz;
+  const float Cx = wt_axis(C, r.kx) - r.sx * Cz, Cy = wt_axis(C, r.ky) - r.sy * Cz;
+  float U = Cx * By - Cy * Bx;
+  float V = Ax * Cy - Ay * Cx;
+  float W = Bx * Ay - By * Ax;
+  if (U == 0.0f || V == 0.0f || W == 0.0f) {
+    // Exactly on an edge in float: decide in double, where these products are exact.
+    U = float(double(Cx) * double(By) - double(Cy) * double(Bx));
+    V = float(double(Ax) * double(Cy) - double(Ay) * double(Cx));
+    W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
+  }
+  if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
+  const float det = U + V + W;
+  if (det == 0.0f) return false;
+  const float T = U * (r.sz * Az) + V * (r.sz * Bz) + W * (r.sz * Cz);
+  // 0 < T / det < t_max without dividing (both sides of the sign of det).
+  if (det > 0.0f) {
+    if (!(T > 0.0f) || !(T < t_max * det)) return false;
+  } else {
+    if (!(T < 0.0f) || !(T > t_max * det)) return false;
+  }
+  t = T / det;
+  return t > 0.0f && t < t_max;
+}
+
+}  // namespace pb::gpu

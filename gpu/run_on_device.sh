@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Builds, tests, sanitizes and benchmarks the GPU tracer on a GPU host (the device
+# machine), writing everything under $OUT (default: ./device-out). Phases are chosen
+# by arguments: build test sanitize bench ico (default: all).
+#   source .gpu-deps/unpack.sh is done here; see ../shared/gpu-host/README.md.
+set -uo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+OUT=${OUT:-$PWD/device-out}
+mkdir -p "$OUT/logs" "$OUT/json"
+pack() {
+  tar czf "$OUT/device-results.tar.gz" -C "$OUT" logs json summary.txt 2>/dev/null
+  rm -rf "$OUT/logs" "$OUT/json"
+}
+trap pack EXIT
+phases=${*:-build test sanitize bench ico}
+has() { [[ " $phases " == *" $1 "* ]]; }
+log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
+B=build-gpu
+PB=$B/bin/pathbench
+
+if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi
+nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.sm,clocks.max.sm --format=csv | tee "$OUT/logs/nvidia-smi.txt"
+
+if has build; then
+  log "configure + build"
+  cmake -S . -B $B -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF \
+        -DCMAKE_CUDA_ARCHITECTURES=90 -DPATHBENCH_CUDA_RESOURCE_REPORT=ON > "$OUT/logs/configure.txt" 2>&1 \
+    || { tail -30 "$OUT/logs/configure.txt"; exit 1; }
+  cmake --build $B -j 16 --target pathbench pathbench_gpu_tests pathbench_traversal_tests > "$OUT/logs/build.txt" 2>&1 \
+    || { grep -E "error|FAILED" -A3 "$OUT/logs/build.txt" | head -60; exit 1; }
+  cmake --build $B -j 16 > "$OUT/logs/build-all.txt" 2>&1 || log "warning: building everything else failed (see build-all.txt)"
+  grep -E "Compiling entry|stack frame|registers" "$OUT/logs/build.txt" > "$OUT/logs/ptxas.txt" || true
+  log "build ok"
+fi
+
+if has test; then
+  log "ctest -L gpu"
+  (cd $B && ctest -L gpu --output-on-failure -V --timeout 300) > "$OUT/logs/ctest-gpu.txt" 2>&1
+  log "ctest -L gpu rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-gpu.txt)"
+  grep -E "INFO|FAILED|Failure" "$OUT/logs/ctest-gpu.txt" | sed 's/^[0-9]*: //' | sort -u | tee -a "$OUT/summary.txt"
+  log "ctest -L unit"
+  (cd $B && ctest -L unit --output-on-failure -j 16 --timeout 600) > "$OUT/logs/ctest-unit.txt" 2>&1
+  log "ctest -L unit rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-unit.txt)"
+fi
+
+render() {  # name, then pathbench render arguments
+  local name=$1; shift
+  timeout 120 $PB render --device gpu --quiet --report "$OUT/json/$name.json" "$@" > "$OUT/logs/$name.txt" 2>&1
+  local rc=$?
+  python3 - "$OUT/json/$name.json" "$name" "$rc" <<'PY' | tee -a "$OUT/summary.txt"
+import json, sys
+path, name, rc = sys.argv[1], sys.argv[2], sys.argv[3]
+try:
+    j = json.load(open(path))
+except Exception:
+    print(f"{name}: rc={rc} (no report)"); sys.exit()
+print(f"{name}: rc={rc} device {j['device_seconds']*1e3:.2f} ms, wall {j['seconds']*1e3:.1f} ms, "
+      f"{j['rays']['total']/j['device_seconds']/1e9:.2f} Grays/s, peak device {j['peak_device_bytes']/1e6:.1f} MB "
+      f"(alloc {j.get('device_bytes_allocated_peak',0)/1e6:.1f}, meminfo {j.get('device_bytes_meminfo_delta_peak',0)/1e6:.1f}), "
+      f"state {j['state_bytes_per_path']} B/path, pif {j['paths_in_flight']}, discarded {j['discarded_samples']}")
+PY
+}
+paper="--scene paper-cornell --width 256 --height 256 --spp 800 --bounces 2 --sampling nee"
+
+if has sanitize; then
+  small="--scene paper-cornell --width 32 --height 32 --spp 4 --bounces 2 --sampling nee --device gpu --quiet"
+  for tool in memcheck racecheck; do
+    for st in pixel wavefront paper-queue; do
+      log "compute-sanitizer $tool $st"
+      timeout 120 compute-sanitizer --tool $tool --print-limit 20 $PB render $small --strategy $st --paths-in-flight 1000 \
+        > "$OUT/logs/sanitizer-$tool-$st.txt" 2>&1
+      echo "rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' $OUT/logs/sanitizer-$tool-$st.txt)" | tee -a "$OUT/summary.txt"
+    done
+  done
+fi
+
+if has bench; then
+  log "paper-cornell 256x256x800, 2 bounces, nee"
+  for i in 1 2 3 4 5; do render paper-pixel-$i $paper --strategy pixel; done
+  for i in 1 2 3; do render paper-wavefront-$i $paper --strategy wavefront; done
+  render paper-paperqueue $paper --strategy paper-queue
+  log "profiles"
+  timeout 60 $PB render --device gpu --quiet $paper --strategy pixel --profile | tee -a "$OUT/summary.txt"
+  timeout 60 $PB render --device gpu --quiet $paper --strategy wavefront --profile | tee -a "$OUT/summary.txt"
+  timeout 60 $PB render --device gpu --quiet $paper --strategy paper-queue --profile | tee -a "$OUT/summary.txt"
+  log "2048x2048x1024"
+  big="--scene paper-cornell --width 2048 --height 2048 --spp 1024 --bounces 2 --sampling nee"
+  render big-wavefront $big --strategy wavefront
+  render big-pixel $big --strategy pixel
+  timeout 60 $PB render --device gpu --quiet $big --strategy paper-queue > "$OUT/logs/big-paperqueue-refusal.txt" 2>&1
+  echo "paper-queue 2048x2048x1024: rc=$? $(cat $OUT/logs/big-paperqueue-refusal.txt)" | tee -a "$OUT/summary.txt"
+fi
+
+if has ico; then
+  log "paper-cornell-ico:8 256x256x800, 2 bounces, nee"
+  ico="--scene paper-cornell-ico:8 --width 256 --height 256 --spp 800 --bounces 2 --sampling nee"
+  for i in 1 2 3; do render ico-pixel-$i $ico --strategy pixel; done
+  render ico-wavefront $ico --strategy wavefront
+  timeout 60 $PB render --device gpu --quiet $ico --strategy pixel --profile | tee -a "$OUT/summary.txt"
+fi
+
+log "done"

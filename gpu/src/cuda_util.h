@@ -1,0 +1,144 @@
+#pragma once
+// CUDA plumbing for the tracer: checked calls (with the call site), tracked device
+// allocations (own count + cudaMemGetInfo), and the one named launch wrapper that
+// picks block sizes and times every launch with CUDA events per stage name.
+#include <cuda_runtime.h>
+#include <fmt/core.h>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pathbench/common/errors.h"
+
+namespace pb::gpu {
+
+[[noreturn]] void cuda_fail(cudaError_t e, const char* what, const char* file, int line);
+inline void cuda_check(cudaError_t e, const char* what, const char* file, int line) {
+  if (e != cudaSuccess) cuda_fail(e, what, file, line);
+}
+#define PB_CUDA_CHECK(expr) ::pb::gpu::cuda_check((expr), #expr, __FILE__, __LINE__)
+
+// Every device allocation of the tracer goes through here.
+class DeviceMemory {
+ public:
+  static DeviceMemory& instance();
+  // `what`: what the memory is for; `lower`: the setting(s) a user can lower when it
+  // does not fit. Checks cudaMemGetInfo first and throws InputError naming both.
+  void* allocate(uint64_t bytes, const char* what, const char* lower);
+  void release(void* p);
+  // Starts a new peak measurement: own bytes and the device's free memory now.
+  void begin_measurement();
+  void sample();  // notes the device's free memory (call after allocations / launches)
+  uint64_t current() const { return current_; }
+  uint64_t peak_allocated() const { return peak_; }
+  uint64_t peak_meminfo_delta() const { return free_at_begin_ > min_free_ ? free_at_begin_ - min_free_ : 0; }
+  static uint64_t free_bytes();
+
+ private:
+  std::map<void*, uint64_t> sizes_;
+  uint64_t current_ = 0, peak_ = 0;
+  uint64_t free_at_begin_ = 0, min_free_ = 0;
+};
+
+template <class T> class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(uint64_t n, const char* what, const char* lower) { allocate(n, what, lower); }
+  ~DeviceBuffer() { reset(); }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  DeviceBuffer(DeviceBuffer&& o) noexcept : p_(o.p_), n_(o.n_) { o.p_ = nullptr; o.n_ = 0; }
+  DeviceBuffer& operator=(DeviceBuffer&& o) noexcept {
+    if (this != &o) { reset(); p_ = o.p_; n_ = o.n_; o.p_ = nullptr; o.n_ = 0; }
+    return *this;
+  }
+  void allocate(uint64_t n, const char* what, const char* lower) {
+    reset();
+    if (n == 0) return;
+    p_ = static_cast<T*>(DeviceMemory::instance().allocate(n * sizeof(T), what, lower));
+    n_ = n;
+  }
+  void reset() {
+    if (p_) DeviceMemory::instance().release(p_);
+    p_ = nullptr;
+    n_ = 0;
+  }
+  void upload(const T* src, uint64_t n) {
+    if (n) PB_CUDA_CHECK(cudaMemcpy(p_, src, n * sizeof(T), cudaMemcpyHostToDevice));
+  }
+  void download(T* dst, uint64_t n) const {
+    if (n) PB_CUDA_CHECK(cudaMemcpy(dst, p_, n * sizeof(T), cudaMemcpyDeviceToHost));
+  }
+  T* get() const { return p_; }
+  uint64_t size() const { return n_; }
+  uint64_t bytes() const { return n_ * sizeof(T); }
+
+ private:
+  T* p_ = nullptr;
+  uint64_t n_ = 0;
+};
+
+// The launch wrapper. Each kernel's block size comes from the occupancy calculator
+// (cached); launches are counted per stage name and, when profiling, bracketed by CUDA
+// events whose times are summed per name after the frame.
+class Launcher {
+ public:
+  Launcher(cudaStream_t stream, bool profile) : stream_(stream), profile_(profile) {}
+  ~Launcher();
+  Launcher(const Launcher&) = delete;
+  Launcher& operator=(const Launcher&) = delete;
+
+  // `threads` total threads (grid = ceil(threads / block)); 0: one full wave of the
+  // device (blocks per multiprocessor at full occupancy x multiprocessors), for kernels
+  // that loop over a count they read on the device.
+  template <class... KArgs, class... Args>
+  void launch(const char* name, void (*kernel)(KArgs...), uint64_t threads, Args&&... args) {
+    Stage& st = stage(name, reinterpret_cast<const void*>(kernel));
+    uint64_t grid = threads == 0 ? uint64_t(st.full_wave_blocks) : (threads + st.block - 1) / st.block;
+    if (grid == 0) return;
+    if (grid > 0x7FFFFFFFull) grid = 0x7FFFFFFFull;  // kernels loop (grid stride)
+    cudaEvent_t ev[2] = {nullptr, nullptr};
+    if (profile_) {
+      ev[0] = next_event();
+      ev[1] = next_event();
+      PB_CUDA_CHECK(cudaEventRecord(ev[0], stream_));
+    }
+    kernel<<<unsigned(grid), unsigned(st.block), 0, stream_>>>(std::forward<Args>(args)...);
+    const cudaError_t e = cudaGetLastError();
+    if (e != cudaSuccess) cuda_fail(e, name, __FILE__, __LINE__);
+    ++st.launches;
+    if (profile_) {
+      PB_CUDA_CHECK(cudaEventRecord(ev[1], stream_));
+      st.events.push_back({ev[0], ev[1]});
+    }
+  }
+  int block_size(const char* name) const;
+  // After the stream is synchronised: per-stage table, and its JSON form.
+  nlohmann::json collect();
+  static std::string format_table(const nlohmann::json& profile);
+  void clear();  // forget counts and times (after a warm-up)
+  bool profiling() const { return profile_; }
+
+ private:
+  struct Stage {
+    const void* kernel = nullptr;
+    int block = 256;
+    int full_wave_blocks = 1;
+    uint64_t launches = 0;
+    std::vector<std::pair<cudaEvent_t, cudaEvent_t>> events;
+  };
+  Stage& stage(const char* name, const void* kernel);
+  cudaEvent_t next_event();
+  cudaStream_t stream_;
+  bool profile_;
+  std::map<std::string, Stage> stages_;
+  std::vector<std::string> order_;
+  std::vector<cudaEvent_t> pool_;
+  size_t pool_used_ = 0;
+};
+
+}  // namespace pb::gpu

@@ -1,0 +1,823 @@
+// The CUDA tracer: scene upload, the three strategies and the run report.
+#include "pathbench/gpu/render.h"
+
+#include <cuda_runtime.h>
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "cuda_util.h"
+#include "pathbench/common/errors.h"
+#include "pathbench/common/path.h"
+#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/bvh_build.h"
+
+#ifndef PATHBENCH_CUDA_ARCHS
+#define PATHBENCH_CUDA_ARCHS "?"
+#endif
+
+namespace pb::gpu {
+
+namespace {
+
+constexpr unsigned kFullMask = 0xFFFFFFFFu;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// film.cpp's kMaxSum: the largest per-pixel fixed-point sum (2^62). Film::acceptable
+// rejects a sample whose channel reaches a quarter of it divided by the scale; the
+// device applies the same limit (tests/gpu checks the two agree).
+constexpr double kFilmMaxSum = 4611686018427387904.0;
+
+// ---------------------------------------------------------------------------------
+// Film and counters on the device.
+
+struct FilmDev {
+  unsigned long long* sum;  // 3 per pixel, two's complement of Film's int64 sums
+  uint32_t* count;
+  double* sum_sq;           // null unless variance is kept
+  double scale;
+  double limit;             // a channel must stay strictly below this (Film::acceptable)
+};
+
+__device__ __forceinline__ bool sample_acceptable(const Vec3f& L, double limit) {
+  return isfinite(L.x) && isfinite(L.y) && isfinite(L.z) && double(fabsf(L.x)) < limit &&
+         double(fabsf(L.y)) < limit && double(fabsf(L.z)) < limit;
+}
+
+struct Stats {
+  unsigned long long camera, bounce, shadow, paths, discarded;
+};
+
+// ---------------------------------------------------------------------------------
+// Probe kernel: tells whether this build's machine code runs on the device.
+__global__ void k_probe() {}
+
+// ---------------------------------------------------------------------------------
+// pixel: one thread per pixel sample (grid-stride over all samples of the frame, a
+// warp taking 32 consecutive samples), the whole path in registers. Samples of one
+// pixel are summed in the warp (exact integer sums) before one atomic per pixel.
+
+__device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
+                                            uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
+  PathState<float> st;
+  path_begin(s, c, pixel, sample, st);
+  for (;;) {
+    float t;
+    const uint32_t prim = intersect_closest(bvh, st.ray.o, st.ray.d, kInf, t);
+    if (prim == kNoHit) break;
+    ShadowQuery<float> q;
+    bool wants_shadow;
+    const PathEvent ev = path_hit(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
+    if (wants_shadow) {
+      ++n_shadow;
+      if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
+    }
+    if (ev == PathEvent::Done) break;
+    ++n_bounce;
+  }
+  return st.L;
+}
+
+template <class T> __device__ __forceinline__ T shfl_down(T v, int off) { return __shfl_down_sync(kFullMask, v, off); }
+
+__device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths, uint32_t discarded) {
+  __shared__ unsigned long long acc[4];
+  if (threadIdx.x < 4) acc[threadIdx.x] = 0;
+  __syncthreads();
+  bounce = __reduce_add_sync(kFullMask, bounce);
+  shadow = __reduce_add_sync(kFullMask, shadow);
+  paths = __reduce_add_sync(kFullMask, paths);
+  discarded = __reduce_add_sync(kFullMask, discarded);
+  if ((threadIdx.x & 31) == 0) {
+    atomicAdd(&acc[0], bounce);
+    atomicAdd(&acc[1], shadow);
+    atomicAdd(&acc[2], paths);
+    atomicAdd(&acc[3], discarded);
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    atomicAdd(&stats->bounce, acc[0]);
+    atomicAdd(&stats->shadow, acc[1]);
+    atomicAdd(&stats->paths, acc[2]);
+    atomicAdd(&stats->camera, acc[2]);
+    atomicAdd(&stats->discarded, acc[3]);
+  }
+}
+
+template <bool kVariance>
+__global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
+                                               FilmDev film, Stats* stats) {
+  const uint32_t lane = threadIdx.x & 31;
+  const uint64_t warp = (uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
+  const uint64_t warps = (uint64_t(gridDim.x) * blockDim.x) >> 5;
+  uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0, n_discarded = 0;
+  for (uint64_t base = warp * 32; base < total; base += warps * 32) {
+    const uint64_t g = base + lane;
+    const bool valid = g < total;
+    const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
+    Vec3f L{0.0f, 0.0f, 0.0f};
+    if (valid) {
+      L = trace_path(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
+      ++n_paths;
+    }
+    const bool ok = valid && sample_acceptable(L, film.limit);
+    if (valid && !ok) ++n_discarded;
+    long long q0 = ok ? quantize_radiance(L.x, film.scale) : 0;
+    long long q1 = ok ? quantize_radiance(L.y, film.scale) : 0;
+    long long q2 = ok ? quantize_radiance(L.z, film.scale) : 0;
+    uint32_t cnt = ok ? 1u : 0u;
+    double s0 = 0, s1 = 0, s2 = 0;
+    if (kVariance && ok) {
+      s0 = double(L.x) * double(L.x);
+      s1 = double(L.y) * double(L.y);
+      s2 = double(L.z) * double(L.z);
+    }
+    // Segmented sum over lanes of the same pixel (consecutive lanes).
+#pragma unroll
+    for (int off = 1; off < 32; off <<= 1) {
+      const uint32_t p2 = shfl_down(pixel, off);
+      const long long a0 = shfl_down(q0, off), a1 = shfl_down(q1, off), a2 = shfl_down(q2, off);
+      const uint32_t c2 = shfl_down(cnt, off);
+      double b0 = 0, b1 = 0, b2 = 0;
+      if (kVariance) { b0 = shfl_down(s0, off); b1 = shfl_down(s1, off); b2 = shfl_down(s2, off); }
+      if (lane + off < 32 && p2 == pixel) {
+        q0 += a0; q1 += a1; q2 += a2;
+        cnt += c2;
+        if (kVariance) { s0 += b0; s1 += b1; s2 += b2; }
+      }
+    }
+    const uint32_t prev = __shfl_up_sync(kFullMask, pixel, 1);
+    if (valid && cnt && (lane == 0 || prev != pixel)) {
+      unsigned long long* sum = film.sum + size_t(pixel) * 3;
+      atomicAdd(sum + 0, static_cast<unsigned long long>(q0));
+      atomicAdd(sum + 1, static_cast<unsigned long long>(q1));
+      atomicAdd(sum + 2, static_cast<unsigned long long>(q2));
+      atomicAdd(film.count + pixel, cnt);
+      if (kVariance) {
+        double* sq = film.sum_sq + size_t(pixel) * 3;
+        atomicAdd(sq + 0, s0);
+        atomicAdd(sq + 1, s1);
+        atomicAdd(sq + 2, s2);
+      }
+    }
+  }
+  block_stats_add(stats, n_bounce, n_shadow, n_paths, n_discarded);
+}
+
+// ---------------------------------------------------------------------------------
+// wavefront and paper-queue: path state as structure of arrays for `capacity` paths,
+// stage kernels linked by queues. Each stage kernel loops over a count it reads on
+// the device, so the host never waits between stages.
+
+struct QueueCounters {
+  uint32_t ray[2];        // ray queues: [cur] this iteration, [cur ^ 1] next
+  uint32_t shadow, done, free;
+  uint32_t gen_count, gen_free_base, gen_ray_base;
+  uint32_t live;          // paths to intersect this iteration (0: frame finished)
+  uint32_t pad;
+  unsigned long long next_sample, gen_base;
+  Stats stats;
+};
+
+struct Pool {
+  // Path state. Only what the scene and estimator need: the shadow arrays and their
+  // queue exist only with light sampling on a scene with emitters.
+  float4* o;        // ray origin, bsdf_pdf
+  float4* d;        // ray direction, pixel (bits)
+  float4* beta;     // throughput, depth (bits)
+  float4* L;        // radiance, hit triangle (bits; written by intersect)
+  uint32_t* sample;
+  float4* sh_o;     // shadow origin, contribution.x
+  float4* sh_d;     // shadow direction, contribution.y
+  float* sh_c;      // contribution.z
+  uint32_t* ray_q[2];
+  uint32_t* shadow_q;
+  uint32_t* done_q;
+  uint32_t* free_q;
+  QueueCounters* ctr;
+  uint32_t capacity;
+};
+
+__device__ __forceinline__ uint32_t grid_thread() { return blockIdx.x * blockDim.x + threadIdx.x; }
+__device__ __forceinline__ uint32_t grid_threads() { return gridDim.x * blockDim.x; }
+
+// Warp-aggregated append: one atomic per warp.
+__device__ __forceinline__ uint32_t queue_push(uint32_t* counter) {
+  const uint32_t mask = __activemask();
+  const uint32_t lane = threadIdx.x & 31;
+  const int leader = __ffs(mask) - 1;
+  uint32_t base = 0;
+  if (int(lane) == leader) base = atomicAdd(counter, uint32_t(__popc(mask)));
+  base = __shfl_sync(mask, base, leader);
+  return base + uint32_t(__popc(mask & ((1u << lane) - 1u)));
+}
+
+__device__ __forceinline__ PathState<float> load_state(const Pool& p, uint32_t slot, uint32_t& prim) {
+  const float4 o = p.o[slot], d = p.d[slot], b = p.beta[slot], L = p.L[slot];
+  PathState<float> st;
+  st.ray.o = {o.x, o.y, o.z};
+  st.bsdf_pdf = o.w;
+  st.ray.d = {d.x, d.y, d.z};
+  st.pixel = __float_as_uint(d.w);
+  st.beta = {b.x, b.y, b.z};
+  st.depth = __float_as_uint(b.w);
+  st.L = {L.x, L.y, L.z};
+  prim = __float_as_uint(L.w);
+  st.sample = p.sample[slot];
+  return st;
+}
+
+__device__ __forceinline__ void store_state(const Pool& p, uint32_t slot, const PathState<float>& st) {
+  p.o[slot] = make_float4(st.ray.o.x, st.ray.o.y, st.ray.o.z, st.bsdf_pdf);
+  p.d[slot] = make_float4(st.ray.d.x, st.ray.d.y, st.ray.d.z, __uint_as_float(st.pixel));
+  p.beta[slot] = make_float4(st.beta.x, st.beta.y, st.beta.z, __uint_as_float(st.depth));
+  p.L[slot] = make_float4(st.L.x, st.L.y, st.L.z, __uint_as_float(kNoHit));
+}
+
+__global__ void k_pool_init(Pool p) {
+  for (uint32_t i = grid_thread(); i < p.capacity; i += grid_threads()) p.free_q[i] = i;
+  if (grid_thread() == 0) {
+    QueueCounters z{};
+    z.free = p.capacity;
+    *p.ctr = z;
+  }
+}
+
+// One thread: books the previous iteration's counts and plans this one's refill.
+__global__ void k_schedule(Pool p, uint32_t cur, unsigned long long total) {
+  if (grid_thread() != 0) return;
+  QueueCounters& c = *p.ctr;
+  c.stats.bounce += c.ray[cur];  // paths that continued from the last shade
+  c.stats.shadow += c.shadow;
+  c.stats.paths += c.done;
+  const unsigned long long remaining = total - c.next_sample;
+  const uint32_t n = uint32_t(remaining < c.free ? remaining : c.free);
+  c.gen_count = n;
+  c.gen_base = c.next_sample;
+  c.gen_free_base = c.free - n;
+  c.gen_ray_base = c.ray[cur];
+  c.free -= n;
+  c.next_sample += n;
+  c.ray[cur] += n;
+  c.stats.camera += n;
+  c.ray[cur ^ 1] = 0;
+  c.shadow = 0;
+  c.done = 0;
+  c.live = c.ray[cur];
+}
+
+__global__ void k_generate(SceneView s, PathConfig c, Pool p, uint32_t cur, uint32_t pixels) {
+  const QueueCounters& q = *p.ctr;
+  const uint32_t n = q.gen_count;
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const uint32_t slot = p.free_q[q.gen_free_base + i];
+    const unsigned long long g = q.gen_base + i;
+    PathState<float> st;
+    path_begin(s, c, uint32_t(g % pixels), uint32_t(g / pixels), st);
+    store_state(p, slot, st);
+    p.sample[slot] = st.sample;
+    p.ray_q[cur][q.gen_ray_base + i] = slot;
+  }
+}
+
+__global__ void k_intersect(BvhView bvh, Pool p, uint32_t cur) {
+  const uint32_t n = p.ctr->ray[cur];
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const uint32_t slot = p.ray_q[cur][i];
+    const float4 o = p.o[slot], d = p.d[slot];
+    float t;
+    const uint32_t prim = intersect_closest(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
+    reinterpret_cast<float*>(p.L + slot)[3] = __uint_as_float(prim);
+  }
+}
+
+__global__ void k_shade(SceneView s, PathConfig c, Pool p, uint32_t cur) {
+  const uint32_t n = p.ctr->ray[cur];
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const uint32_t slot = p.ray_q[cur][i];
+    uint32_t prim;
+    PathState<float> st = load_state(p, slot, prim);
+    if (prim == kNoHit) {
+      p.done_q[queue_push(&p.ctr->done)] = slot;
+      continue;
+    }
+    ShadowQuery<float> q;
+    bool wants_shadow;
+    const PathEvent ev = path_hit(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
+    store_state(p, slot, st);
+    if (wants_shadow) {
+      p.sh_o[slot] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
+      p.sh_d[slot] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
+      p.sh_c[slot] = q.contribution.z;
+      p.shadow_q[queue_push(&p.ctr->shadow)] = slot;
+    }
+    if (ev == PathEvent::Continue) p.ray_q[cur ^ 1][queue_push(&p.ctr->ray[cur ^ 1])] = slot;
+    else p.done_q[queue_push(&p.ctr->done)] = slot;
+  }
+}
+
+__global__ void k_shadow(BvhView bvh, Pool p) {
+  const uint32_t n = p.ctr->shadow;
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const uint32_t slot = p.shadow_q[i];
+    const float4 o = p.sh_o[slot], d = p.sh_d[slot];
+    if (!occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f)) {
+      float4 L = p.L[slot];
+      L.x = L.x + o.w;  // shadow_unoccluded: L += contribution
+      L.y = L.y + d.w;
+      L.z = L.z + p.sh_c[slot];
+      p.L[slot] = L;
+    }
+  }
+}
+
+template <bool kVariance> __global__ void k_accumulate(Pool p, FilmDev film) {
+  const uint32_t n = p.ctr->done;
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const uint32_t slot = p.done_q[i];
+    const float4 L4 = p.L[slot];
+    const Vec3f L{L4.x, L4.y, L4.z};
+    const uint32_t pixel = __float_as_uint(p.d[slot].w);
+    if (sample_acceptable(L, film.limit)) {
+      unsigned long long* sum = film.sum + size_t(pixel) * 3;
+      atomicAdd(sum + 0, static_cast<unsigned long long>(quantize_radiance(L.x, film.scale)));
+      atomicAdd(sum + 1, static_cast<unsigned long long>(quantize_radiance(L.y, film.scale)));
+      atomicAdd(sum + 2, static_cast<unsigned long long>(quantize_radiance(L.z, film.scale)));
+      atomicAdd(film.count + pixel, 1u);
+      if (kVariance) {
+        double* sq = film.sum_sq + size_t(pixel) * 3;
+        atomicAdd(sq + 0, double(L.x) * double(L.x));
+        atomicAdd(sq + 1, double(L.y) * double(L.y));
+        atomicAdd(sq + 2, double(L.z) * double(L.z));
+      }
+    } else {
+      atomicAdd(&p.ctr->stats.discarded, 1ull);
+    }
+    p.free_q[queue_push(&p.ctr->free)] = slot;
+  }
+}
+
+// ---------------------------------------------------------------------------------
+// Traversal for tests.
+__global__ void k_trace(BvhView bvh, const TraceQuery* rays, TraceResult* out, uint32_t n, bool any_hit) {
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const TraceQuery r = rays[i];
+    float t = r.t_max;
+    uint32_t prim = any_hit ? traverse<true>(bvh, r.o, r.d, r.t_max, t) : traverse<false>(bvh, r.o, r.d, r.t_max, t);
+    out[i] = {prim, t};
+  }
+}
+
+std::string slugify(const std::string& name) {
+  std::string out;
+  for (char ch : name) {
+    if (std::isalnum(static_cast<unsigned char>(ch))) out += char(std::tolower(static_cast<unsigned char>(ch)));
+    else if (!out.empty() && out.back() != '-') out += '-';
+  }
+  while (!out.empty() && out.back() == '-') out.pop_back();
+  return out.empty() ? "unknown-gpu" : out;
+}
+
+void ensure_device() {
+  std::string why;
+  if (!device_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+}
+
+struct ScopedStream {
+  cudaStream_t s = nullptr;
+  ScopedStream() { PB_CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking)); }
+  ~ScopedStream() { if (s) cudaStreamDestroy(s); }
+};
+struct ScopedEvent {
+  cudaEvent_t e = nullptr;
+  ScopedEvent() { PB_CUDA_CHECK(cudaEventCreate(&e)); }
+  ~ScopedEvent() { if (e) cudaEventDestroy(e); }
+};
+
+}  // namespace
+
+// -----------------------------------------------------------------------------------
+// Device facts.
+
+bool device_available(std::string* why_not) {
+  int n = 0;
+  cudaError_t e = cudaGetDeviceCount(&n);
+  if (e != cudaSuccess || n == 0) {
+    (void)cudaGetLastError();
+    if (why_not)
+      *why_not = e != cudaSuccess ? fmt::format("no usable CUDA device ({})", cudaGetErrorString(e))
+                                  : std::string("no CUDA device found");
+    return false;
+  }
+  cudaFuncAttributes attr;
+  e = cudaFuncGetAttributes(&attr, k_probe);
+  if (e != cudaSuccess) {
+    (void)cudaGetLastError();
+    cudaDeviceProp prop{};
+    cudaGetDeviceProperties(&prop, 0);
+    if (why_not)
+      *why_not = fmt::format("this build's kernels (CUDA architectures {}) cannot run on {} (sm_{}{}): {}; rebuild "
+                             "with -DCMAKE_CUDA_ARCHITECTURES={}{}",
+                             PATHBENCH_CUDA_ARCHS, prop.name, prop.major, prop.minor, cudaGetErrorString(e),
+                             prop.major, prop.minor);
+    return false;
+  }
+  return true;
+}
+
+DeviceInfo device_info() {
+  ensure_device();
+  DeviceInfo info;
+  PB_CUDA_CHECK(cudaGetDevice(&info.device));
+  cudaDeviceProp prop{};
+  PB_CUDA_CHECK(cudaGetDeviceProperties(&prop, info.device));
+  info.name = prop.name;
+  info.compute_major = prop.major;
+  info.compute_minor = prop.minor;
+  info.multiprocessors = prop.multiProcessorCount;
+  info.total_memory = prop.totalGlobalMem;
+  PB_CUDA_CHECK(cudaDriverGetVersion(&info.driver_version));
+  PB_CUDA_CHECK(cudaRuntimeGetVersion(&info.runtime_version));
+  info.slug = slugify(info.name);
+  return info;
+}
+
+uint64_t default_paths_in_flight() {
+  const DeviceInfo info = device_info();
+  int threads_per_sm = 0;
+  PB_CUDA_CHECK(cudaDeviceGetAttribute(&threads_per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, info.device));
+  // Eight full waves of threads: enough paths for every stage to fill the device
+  // (about 2.2 million on an H100), at ~120 bytes a path well under 512 MB.
+  return uint64_t(info.multiprocessors) * uint64_t(threads_per_sm) * 8;
+}
+
+// -----------------------------------------------------------------------------------
+// The scene on the device.
+
+struct GpuScene::Impl {
+  DeviceBuffer<Vec3f> positions;
+  DeviceBuffer<Triangle> triangles;
+  DeviceBuffer<uint32_t> material_ids;
+  DeviceBuffer<Material> materials;
+  DeviceBuffer<uint32_t> emitters;
+  DeviceBuffer<float> emitter_cdf;
+  DeviceBuffer<BvhNode> nodes;
+  DeviceBuffer<BvhTriangle> tris;
+  SceneView view{};
+  BvhView bvh{};
+  uint64_t bytes = 0;
+  uint32_t bvh_depth = 0, bvh_leaves = 0;
+  double bvh_sah = 0, bvh_build_seconds = 0, upload_seconds = 0;
+};
+
+GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+  ensure_device();
+  Impl& m = *impl_;
+  const BvhHost bvh = build_bvh(scene);
+  const auto t0 = std::chrono::steady_clock::now();
+  const char* lower = "the scene's size (fewer triangles)";
+  m.positions.allocate(scene.positions.size(), "scene vertices", lower);
+  m.positions.upload(scene.positions.data(), scene.positions.size());
+  m.triangles.allocate(scene.triangles.size(), "scene triangles", lower);
+  m.triangles.upload(scene.triangles.data(), scene.triangles.size());
+  m.material_ids.allocate(scene.material_ids.size(), "material ids", lower);
+  m.material_ids.upload(scene.material_ids.data(), scene.material_ids.size());
+  m.materials.allocate(scene.materials.size(), "materials", lower);
+  m.materials.upload(scene.materials.data(), scene.materials.size());
+  m.emitters.allocate(scene.emitters.size(), "emitter table", lower);
+  m.emitters.upload(scene.emitters.data(), scene.emitters.size());
+  m.emitter_cdf.allocate(scene.emitter_cdf.size(), "emitter table", lower);
+  m.emitter_cdf.upload(scene.emitter_cdf.data(), scene.emitter_cdf.size());
+  m.nodes.allocate(bvh.nodes.size(), "BVH nodes", lower);
+  m.nodes.upload(bvh.nodes.data(), bvh.nodes.size());
+  m.tris.allocate(bvh.tris.size(), "BVH triangles", lower);
+  m.tris.upload(bvh.tris.data(), bvh.tris.size());
+  m.view = scene.view();
+  m.view.positions = m.positions.get();
+  m.view.triangles = m.triangles.get();
+  m.view.material_ids = m.material_ids.get();
+  m.view.materials = m.materials.get();
+  m.view.emitters = m.emitters.get();
+  m.view.emitter_cdf = m.emitter_cdf.get();
+  m.bvh = {m.nodes.get(), m.tris.get(), uint32_t(bvh.nodes.size()), uint32_t(bvh.tris.size())};
+  m.bytes = m.positions.bytes() + m.triangles.bytes() + m.material_ids.bytes() + m.materials.bytes() +
+            m.emitters.bytes() + m.emitter_cdf.bytes() + m.nodes.bytes() + m.tris.bytes();
+  m.bvh_depth = bvh.depth;
+  m.bvh_leaves = bvh.leaves;
+  m.bvh_sah = bvh.sah_cost;
+  m.bvh_build_seconds = bvh.build_seconds;
+  m.upload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+GpuScene::~GpuScene() = default;
+
+// -----------------------------------------------------------------------------------
+// Rendering.
+
+namespace {
+
+struct FilmBuffers {
+  DeviceBuffer<unsigned long long> sum;
+  DeviceBuffer<uint32_t> count;
+  DeviceBuffer<double> sum_sq;
+  FilmDev view{};
+  void allocate(const Film& film, uint64_t pixels) {
+    const char* lower = "--width/--height";
+    sum.allocate(pixels * 3, "the film", lower);
+    count.allocate(pixels, "the film", lower);
+    if (film.has_variance()) sum_sq.allocate(pixels * 3, "the film's variance (--variance-out)", lower);
+    view = {sum.get(), count.get(), sum_sq.get(), film.scale(), kFilmMaxSum / 4 / film.scale()};
+  }
+  void clear(cudaStream_t s) {
+    PB_CUDA_CHECK(cudaMemsetAsync(sum.get(), 0, sum.bytes(), s));
+    PB_CUDA_CHECK(cudaMemsetAsync(count.get(), 0, count.bytes(), s));
+    if (sum_sq.get()) PB_CUDA_CHECK(cudaMemsetAsync(sum_sq.get(), 0, sum_sq.bytes(), s));
+  }
+  uint64_t bytes() const { return sum.bytes() + count.bytes() + sum_sq.bytes(); }
+};
+
+struct FrameResult {
+  Stats stats{};
+  uint64_t state_bytes_per_path = 0, queue_bytes_per_path = 0, paths_in_flight = 0, pool_bytes = 0;
+  uint64_t iterations = 0;
+};
+
+// Path pool shared by wavefront and paper-queue.
+class PathPool {
+ public:
+  PathPool(uint64_t capacity, bool shadows, const char* what, const char* lower) : capacity_(capacity), shadows_(shadows) {
+    o.allocate(capacity, what, lower);
+    d.allocate(capacity, what, lower);
+    beta.allocate(capacity, what, lower);
+    L.allocate(capacity, what, lower);
+    sample.allocate(capacity, what, lower);
+    if (shadows) {
+      sh_o.allocate(capacity, what, lower);
+      sh_d.allocate(capacity, what, lower);
+      sh_c.allocate(capacity, what, lower);
+      shadow_q.allocate(capacity, what, lower);
+    }
+    ray_q[0].allocate(capacity, what, lower);
+    ray_q[1].allocate(capacity, what, lower);
+    done_q.allocate(capacity, what, lower);
+    free_q.allocate(capacity, what, lower);
+    ctr.allocate(1, what, lower);
+    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(QueueCounters)));
+  }
+  ~PathPool() { if (host_ctr_) cudaFreeHost(host_ctr_); }
+  PathPool(const PathPool&) = delete;
+  PathPool& operator=(const PathPool&) = delete;
+
+  static uint64_t state_bytes(bool shadows) {
+    return 4 * sizeof(float4) + sizeof(uint32_t) + (shadows ? 2 * sizeof(float4) + sizeof(float) : 0);
+  }
+  static uint64_t queue_bytes(bool shadows) { return sizeof(uint32_t) * (4 + (shadows ? 1 : 0)); }
+  static uint64_t bytes_per_path(bool shadows) { return state_bytes(shadows) + queue_bytes(shadows); }
+
+  Pool view() const {
+    Pool p{};
+    p.o = o.get(); p.d = d.get(); p.beta = beta.get(); p.L = L.get(); p.sample = sample.get();
+    p.sh_o = sh_o.get(); p.sh_d = sh_d.get(); p.sh_c = sh_c.get();
+    p.ray_q[0] = ray_q[0].get(); p.ray_q[1] = ray_q[1].get();
+    p.shadow_q = shadow_q.get(); p.done_q = done_q.get(); p.free_q = free_q.get();
+    p.ctr = ctr.get();
+    p.capacity = uint32_t(capacity_);
+    return p;
+  }
+
+  // Runs one frame of `total` samples: refills the pool until every sample is done.
+  FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
+                  uint64_t total, uint32_t pixels, FilmDev film, bool variance) {
+    const Pool p = view();
+    launch.launch("pool_init", k_pool_init, capacity_, p);
+    FrameResult r;
+    constexpr int kCheckEvery = 4;  // iterations between looks at the counters
+    for (uint64_t it = 0;; ++it) {
+      const uint32_t cur = uint32_t(it & 1);
+      launch.launch("schedule", k_schedule, 1, p, cur, static_cast<unsigned long long>(total));
+      launch.launch("generate", k_generate, 0, g.view, c, p, cur, pixels);
+      launch.launch("intersect", k_intersect, 0, g.bvh, p, cur);
+      launch.launch("shade", k_shade, 0, g.view, c, p, cur);
+      if (shadows_) launch.launch("shadow", k_shadow, 0, g.bvh, p);
+      if (variance) launch.launch("accumulate", k_accumulate<true>, 0, p, film);
+      else launch.launch("accumulate", k_accumulate<false>, 0, p, film);
+      if (it % kCheckEvery == kCheckEvery - 1) {
+        PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr.get(), sizeof(QueueCounters), cudaMemcpyDeviceToHost, stream));
+        PB_CUDA_CHECK(cudaStreamSynchronize(stream));
+        if (host_ctr_->live == 0 && host_ctr_->next_sample >= total) {
+          r.iterations = it + 1;
+          break;
+        }
+      }
+    }
+    // The last schedule booked everything: every path is done.
+    r.stats = host_ctr_->stats;
+    r.state_bytes_per_path = state_bytes(shadows_);
+    r.queue_bytes_per_path = queue_bytes(shadows_);
+    r.paths_in_flight = capacity_;
+    r.pool_bytes = capacity_ * bytes_per_path(shadows_) + sizeof(QueueCounters);
+    return r;
+  }
+
+ private:
+  uint64_t capacity_;
+  bool shadows_;
+  DeviceBuffer<float4> o, d, beta, L;
+  DeviceBuffer<uint32_t> sample;
+  DeviceBuffer<float4> sh_o, sh_d;
+  DeviceBuffer<float> sh_c;
+  DeviceBuffer<uint32_t> ray_q[2], shadow_q, done_q, free_q;
+  DeviceBuffer<QueueCounters> ctr;
+  QueueCounters* host_ctr_ = nullptr;
+};
+
+FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+                      uint64_t total, FilmDev film, bool variance, DeviceBuffer<Stats>& stats) {
+  PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
+  if (variance) launch.launch("pixel", k_pixel<true>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
+  else launch.launch("pixel", k_pixel<false>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
+  FrameResult r;
+  PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, stats.get(), sizeof(Stats), cudaMemcpyDeviceToHost, stream));
+  PB_CUDA_CHECK(cudaStreamSynchronize(stream));
+  r.state_bytes_per_path = 0;  // in registers
+  return r;
+}
+
+void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
+                 RunReport& report, bool profile);
+}  // namespace
+
+void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile) {
+  ensure_device();
+  settings.validate();
+  // Start the context before measuring memory: its own use is not the tracer's.
+  PB_CUDA_CHECK(cudaFree(nullptr));
+  DeviceMemory::instance().begin_measurement();
+  GpuScene gpu_scene(scene);
+  render_impl(scene, gpu_scene, settings, film, report, profile);
+}
+
+void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film, RunReport& report,
+            bool profile) {
+  ensure_device();
+  settings.validate();
+  DeviceMemory::instance().begin_measurement();
+  render_impl(scene, gpu_scene, settings, film, report, profile);
+}
+
+namespace {
+void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
+                 RunReport& report, bool profile) {
+  if (film.width() != settings.width || film.height() != settings.height)
+    throw std::logic_error("film size does not match the settings");
+  const DeviceInfo info = device_info();
+  const GpuScene::Impl& g = gpu_scene.impl();
+  DeviceMemory& mem = DeviceMemory::instance();
+
+  const PathConfig config = settings.path_config();
+  const uint32_t pixels = settings.width * settings.height;
+  const uint64_t total = settings.total_samples();
+  const bool shadows = settings.sampling == Sampling::Nee && !scene.emitters.empty();
+  film.begin(settings.spp, scene.max_emission());
+
+  ScopedStream stream;
+  Launcher launch(stream.s, profile);
+  FilmBuffers fb;
+  fb.allocate(film, pixels);
+
+  // Strategy resources.
+  std::unique_ptr<PathPool> pool;
+  DeviceBuffer<Stats> pixel_stats;
+  uint64_t warmup_total = std::min<uint64_t>(total, pixels);
+  if (settings.strategy == Strategy::Pixel) {
+    pixel_stats.allocate(1, "counters", "nothing (8 bytes)");
+  } else if (settings.strategy == Strategy::Wavefront) {
+    uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight();
+    pif = std::min<uint64_t>(pif, total);
+    pif = std::max<uint64_t>(pif, 1);
+    if (pif > 0xFFFFFFFFull) throw InputError("--paths-in-flight: at most 4294967295 paths");
+    pool = std::make_unique<PathPool>(pif, shadows, "the wavefront path pool", "--paths-in-flight");
+  } else {
+    // The paper's global queue: a task for every path of the frame, all at once.
+    const uint64_t per_task = PathPool::bytes_per_path(shadows);
+    const uint64_t need = total * per_task;
+    const uint64_t free_b = DeviceMemory::free_bytes();
+    if (total > 0xFFFFFFFFull || need + (64ull << 20) > free_b)
+      throw InputError(fmt::format(
+          "--strategy paper-queue: the paper's global queue holds every path of the frame up front: {}x{} pixels x {} "
+          "spp = {} tasks x {} bytes = {:.2f} GB, but the GPU ({}) has {:.2f} GB free{}; lower --spp or "
+          "--width/--height, or use --strategy wavefront (memory bounded by --paths-in-flight)",
+          settings.width, settings.height, settings.spp, total, per_task, need / 1e9, info.name, free_b / 1e9,
+          total > 0xFFFFFFFFull ? " (and more than 2^32 - 1 tasks cannot be indexed)" : ""));
+    pool = std::make_unique<PathPool>(total, shadows, "the paper-queue global task queue", "--spp or --width/--height");
+    warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
+  }
+
+  auto run_frame = [&](uint64_t n) {
+    if (settings.strategy == Strategy::Pixel)
+      return run_pixel(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance(), pixel_stats);
+    return pool->run(launch, stream.s, g, config, n, pixels, fb.view, film.has_variance());
+  };
+
+  // Warm-up (module load, first-touch of every buffer), then the timed frame.
+  fb.clear(stream.s);
+  run_frame(warmup_total);
+  PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
+  mem.sample();
+  launch.clear();
+  fb.clear(stream.s);
+
+  ScopedEvent ev0, ev1;
+  PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
+  const auto t0 = std::chrono::steady_clock::now();
+  PB_CUDA_CHECK(cudaEventRecord(ev0.e, stream.s));
+  const FrameResult r = run_frame(total);
+  PB_CUDA_CHECK(cudaEventRecord(ev1.e, stream.s));
+  PB_CUDA_CHECK(cudaEventSynchronize(ev1.e));
+  const auto t1 = std::chrono::steady_clock::now();
+  mem.sample();
+  float device_ms = 0;
+  PB_CUDA_CHECK(cudaEventElapsedTime(&device_ms, ev0.e, ev1.e));
+
+  // Film back to the host: the device's unsigned sums are Film's int64 sums mod 2^64.
+  static_assert(sizeof(unsigned long long) == sizeof(int64_t));
+  fb.sum.download(reinterpret_cast<unsigned long long*>(film.raw_sums().data()), fb.sum.size());
+  fb.count.download(film.counts().data(), fb.count.size());
+  if (film.has_variance()) fb.sum_sq.download(film.raw_sum_sq().data(), fb.sum_sq.size());
+
+  report.scene = scene.name;
+  report.triangles = scene.triangles.size();
+  report.settings = settings;
+  report.seconds = std::chrono::duration<double>(t1 - t0).count();
+  report.device_seconds = double(device_ms) / 1e3;
+  report.rays.camera = r.stats.camera;
+  report.rays.bounce = r.stats.bounce;
+  report.rays.shadow = r.stats.shadow;
+  report.paths = r.stats.paths;
+  report.discarded_samples = r.stats.discarded;
+  report.state_bytes_per_path = r.state_bytes_per_path;
+  report.paths_in_flight = r.paths_in_flight;
+  report.threads = 0;
+  report.peak_host_bytes = peak_resident_bytes();
+  report.tracer_host_bytes = film.bytes();
+  report.peak_device_bytes = std::max(mem.peak_allocated(), mem.peak_meminfo_delta());
+  auto& x = report.extra;
+  x["gpu"] = {{"name", info.name},
+              {"slug", info.slug},
+              {"compute_capability", fmt::format("{}.{}", info.compute_major, info.compute_minor)},
+              {"multiprocessors", info.multiprocessors},
+              {"memory_bytes", info.total_memory},
+              {"driver_version", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10)},
+              {"cuda_runtime_version", fmt::format("{}.{}", info.runtime_version / 1000, (info.runtime_version % 1000) / 10)},
+              {"cuda_architectures_built", PATHBENCH_CUDA_ARCHS}};
+  x["device_bytes_allocated_peak"] = mem.peak_allocated();
+  x["device_bytes_meminfo_delta_peak"] = mem.peak_meminfo_delta();
+  x["film_device_bytes"] = fb.bytes();
+  x["scene_device_bytes"] = g.bytes;
+  x["bvh"] = {{"nodes", g.bvh.num_nodes}, {"triangle_refs", g.bvh.num_tris}, {"leaves", g.bvh_leaves},
+              {"depth", g.bvh_depth}, {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
+              {"builder", "embree rtcBuildBVH, binned SAH, binary"}};
+  x["device_samples_per_second"] = device_ms > 0 ? double(r.stats.paths) / (device_ms / 1e3) : 0.0;
+  x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
+  x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
+  if (settings.strategy != Strategy::Pixel) {
+    x["queue_bytes_per_path"] = r.queue_bytes_per_path;
+    x["pool_device_bytes"] = r.pool_bytes;
+    x["iterations"] = r.iterations;
+  }
+  if (settings.strategy == Strategy::PaperQueue) {
+    x["bytes_per_task"] = r.state_bytes_per_path + r.queue_bytes_per_path;
+    x["tasks"] = total;
+  }
+  if (settings.strategy == Strategy::Pixel) x["pixel_block"] = launch.block_size("pixel");
+  if (profile) {
+    const nlohmann::json prof = launch.collect();
+    x["profile"] = prof;
+    std::fputs(Launcher::format_table(prof).c_str(), stdout);
+  }
+  if (settings.strategy == Strategy::Pixel)
+    x["paths_in_flight_note"] = "pixel: one thread per sample, path state in registers";
+}
+}  // namespace
+
+// -----------------------------------------------------------------------------------
+std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit) {
+  ensure_device();
+  const GpuScene gs(scene);
+  DeviceBuffer<TraceQuery> d_rays(rays.size(), "test rays", "the number of rays");
+  DeviceBuffer<TraceResult> d_out(rays.size(), "test results", "the number of rays");
+  d_rays.upload(rays.data(), rays.size());
+  std::vector<TraceResult> out(rays.size());
+  if (rays.empty()) return out;
+  Launcher launch(nullptr, false);
+  launch.launch("trace", k_trace, rays.size(), gs.impl().bvh, d_rays.get(), d_out.get(), uint32_t(rays.size()), any_hit);
+  PB_CUDA_CHECK(cudaDeviceSynchronize());
+  d_out.download(out.data(), out.size());
+  return out;
+}
+
+}  // namespace pb::gpu

@@ -1,0 +1,241 @@
+// GPU tracer tests (CTest label `gpu`). Without a usable CUDA device every test reports
+// SKIPPED with the reason, and CTest counts it as passed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/common/scene_library.h"
+#include "pathbench/cpu/render.h"
+#include "pathbench/gpu/bvh_build.h"
+#include "pathbench/gpu/render.h"
+#include "traversal_check.h"
+#if __has_include("../unit/stat_test.h")
+#include "../unit/stat_test.h"
+#define PB_HAVE_STAT_TEST 1
+#endif
+
+namespace pb::gpu {
+namespace {
+
+#define PB_REQUIRE_GPU()                                        \
+  do {                                                          \
+    std::string why;                                            \
+    if (!device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
+  } while (0)
+
+RenderSettings small_settings(Strategy strategy, uint32_t size = 64, uint32_t spp = 32) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.max_bounces = 2;
+  s.sampling = Sampling::Nee;
+  s.strategy = strategy;
+  s.device = Device::Gpu;
+  s.seed = 1234;
+  s.progress = false;
+  return s;
+}
+
+Film render_gpu(const Scene& scene, const GpuScene& gs, RenderSettings s, RunReport* out = nullptr) {
+  Film film(s.width, s.height, s.variance);
+  RunReport r;
+  render(scene, gs, s, film, r, false);
+  EXPECT_EQ(r.paths, s.total_samples());
+  EXPECT_EQ(r.discarded_samples, 0u);
+  if (out) *out = r;
+  return film;
+}
+
+void expect_identical(const Film& a, const Film& b, const char* what) {
+  ASSERT_EQ(a.raw_sums().size(), b.raw_sums().size());
+  size_t differ = 0;
+  for (size_t i = 0; i < a.raw_sums().size(); ++i) differ += a.raw_sums()[i] != b.raw_sums()[i];
+  EXPECT_EQ(differ, 0u) << what << ": film sums differ in " << differ << " values";
+  EXPECT_EQ(a.counts(), b.counts()) << what;
+}
+
+struct StrategyCase {
+  const char* scene;
+  Sampling sampling;
+  int bounces;  // -1: unbounded with Russian roulette
+};
+
+class GpuStrategies : public ::testing::TestWithParam<StrategyCase> {};
+
+// pixel, wavefront (small pool: many refills) and paper-queue: bit-identical films.
+TEST_P(GpuStrategies, BitIdenticalFilms) {
+  PB_REQUIRE_GPU();
+  Scene scene;
+  try {
+    scene = load_scene(GetParam().scene);
+  } catch (const InputError& e) {
+    GTEST_SKIP() << "scene " << GetParam().scene << " not available: " << e.what();
+  }
+  const GpuScene gs(scene);
+  RenderSettings s = small_settings(Strategy::Pixel, 48, 24);
+  s.sampling = GetParam().sampling;
+  s.max_bounces = GetParam().bounces;
+  s.russian_roulette = s.max_bounces < 0;
+  const Film pixel = render_gpu(scene, gs, s);
+  s.strategy = Strategy::Wavefront;
+  s.paths_in_flight = 3001;  // odd size, many refills
+  RunReport wr;
+  const Film wave = render_gpu(scene, gs, s, &wr);
+  EXPECT_GT(wr.state_bytes_per_path, 0u);
+  expect_identical(pixel, wave, "pixel vs wavefront");
+  s.paths_in_flight = 0;  // device default
+  expect_identical(pixel, render_gpu(scene, gs, s), "pixel vs wavefront (default pool)");
+  s.strategy = Strategy::PaperQueue;
+  expect_identical(pixel, render_gpu(scene, gs, s), "pixel vs paper-queue");
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, GpuStrategies,
+                         ::testing::Values(StrategyCase{"paper-cornell", Sampling::Nee, 2},
+                                           StrategyCase{"paper-cornell", Sampling::Uniform, 2},
+                                           StrategyCase{"paper-cornell", Sampling::Cosine, -1},
+                                           StrategyCase{"cornell-box", Sampling::Nee, -1},
+                                           StrategyCase{"paper-cornell-ico:3", Sampling::Nee, 3}));
+
+// GPU against the CPU tracer, same seed and settings: with one random stream the
+// images differ only where rounding sends a path to another triangle.
+void gpu_vs_cpu(const char* name) {
+  Scene scene;
+  try {
+    scene = load_scene(name);
+  } catch (const InputError& e) {
+    GTEST_SKIP() << "scene " << name << " not available: " << e.what();
+  }
+  RenderSettings s = small_settings(Strategy::Pixel, 64, 64);
+  s.variance = true;
+  Film gpu_film(s.width, s.height, true), cpu_film(s.width, s.height, true);
+  RunReport gr, cr;
+  render(scene, s, gpu_film, gr, false);
+  RenderSettings sc = s;
+  sc.device = Device::Cpu;
+  cpu::render(scene, sc, cpu_film, cr);
+  const auto g = gpu_film.mean(), c = cpu_film.mean();
+  size_t within = 0, differ_at_all = 0;
+  double worst = 0;
+  const size_t pixels = size_t(s.width) * s.height;
+  for (size_t p = 0; p < pixels; ++p) {
+    bool ok = true, same = true;
+    for (int k = 0; k < 3; ++k) {
+      const double a = g[p * 3 + k], b = c[p * 3 + k];
+      const double rel = std::fabs(a - b) / std::max({std::fabs(a), std::fabs(b), 1e-30});
+      if (a != b) rel > 0 ? worst = std::max(worst, rel) : 0;
+      if (!(rel <= 1e-4)) ok = false;
+      if (gpu_film.raw_sums()[p * 3 + k] != cpu_film.raw_sums()[p * 3 + k]) same = false;
+    }
+    within += ok;
+    differ_at_all += !same;
+  }
+  const double share = double(within) / double(pixels);
+  std::printf("[ INFO     ] %s GPU vs CPU, %ux%u, %u spp: %.4f%% of pixels within 1e-4 relative; %.4f%% of pixels differ "
+              "at all (film sums); largest relative difference %.3g\n",
+              name, s.width, s.height, s.spp, 100.0 * share, 100.0 * double(differ_at_all) / double(pixels), worst);
+  ::testing::Test::RecordProperty("share_within_1e-4", std::to_string(share));
+  ::testing::Test::RecordProperty("share_differing", std::to_string(double(differ_at_all) / double(pixels)));
+  EXPECT_GE(share, 0.99);
+  EXPECT_EQ(gr.paths, cr.paths);
+#if PB_HAVE_STAT_TEST
+  const auto t = stat::compare_images(g, gpu_film.variance_of_mean(), c, cpu_film.variance_of_mean());
+  std::printf("[ INFO     ] %s statistical test: %s\n", name, t.summary().c_str());
+  EXPECT_EQ(t.passed, t.values) << t.summary();
+#endif
+}
+
+TEST(GpuVsCpu, PaperCornell) {
+  PB_REQUIRE_GPU();
+  gpu_vs_cpu("paper-cornell");
+}
+TEST(GpuVsCpu, CornellBox) {
+  PB_REQUIRE_GPU();
+  gpu_vs_cpu("cornell-box");
+}
+
+// The traversal cross-check of tests/gpu/test_traversal.cpp, run on the device: the
+// device traversal returns what the host traversal returns, and agrees with Embree.
+TEST(GpuTraversal, DeviceMatchesHostAndEmbree) {
+  PB_REQUIRE_GPU();
+  for (const char* name : {"paper-cornell", "paper-cornell-ico:3"}) {
+    Scene scene;
+    try {
+      scene = load_scene(name);
+    } catch (const InputError&) {
+      continue;
+    }
+    const BvhHost bvh = build_bvh(scene);
+    const Vec3f ext = scene.bounds_max - scene.bounds_min;
+    const Vec3f lo = scene.bounds_min + ext * 0.02f, hi = scene.bounds_max - ext * 0.02f;
+    auto rays = test::random_rays(lo, hi, 20000, 9);
+    const auto edge = test::edge_and_vertex_rays(scene, lo, hi, 8, 13);
+    rays.insert(rays.end(), edge.begin(), edge.end());
+    std::vector<TraceQuery> q(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) q[i] = {rays[i].o, rays[i].d, rays[i].t_max};
+    const auto dev = trace_on_device(scene, q, false);
+    const test::EmbreeReference ref(scene);
+    test::Agreement with_host, with_embree;
+    with_embree.edge_rays = true;  // random rays plus rays aimed at edges (see test_traversal.cpp)
+    size_t misses = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      test::Hit h;
+      h.prim = traverse<false>(bvh.view(), rays[i].o, rays[i].d, rays[i].t_max, h.t);
+      const test::Hit d{dev[i].prim, dev[i].t};
+      with_host.add(rays[i], d, h);  // same code on both sides: no tolerance for edges needed
+      misses += d.prim == kNoHit;
+      const test::Hit e = ref.closest(rays[i]);
+      if (e.prim != kNoHit) with_embree.add(rays[i], d, e, test::hit_cos(scene, rays[i], d));
+    }
+    std::printf("[ INFO     ] %s device traversal: %zu rays; vs host: %zu hit/miss, %zu prim (%zu not ties), %zu t; "
+                "vs Embree: %zu hit/miss, %zu prim (%zu not ties), %zu t; %zu misses\n",
+                name, rays.size(), with_host.hit_miss_mismatch, with_host.prim_mismatch, with_host.prim_mismatch_not_tie,
+                with_host.t_mismatch, with_embree.hit_miss_mismatch, with_embree.prim_mismatch,
+                with_embree.prim_mismatch_not_tie, with_embree.t_mismatch, misses);
+    EXPECT_EQ(misses, 0u) << name << ": closed scene, every ray must hit";
+    EXPECT_EQ(with_host.hit_miss_mismatch, 0u) << with_host.first_problem;
+    EXPECT_EQ(with_host.prim_mismatch_not_tie, 0u) << with_host.first_problem;
+    EXPECT_EQ(with_host.t_mismatch, 0u) << with_host.first_problem;
+    EXPECT_EQ(with_embree.prim_mismatch_not_tie, 0u) << with_embree.first_problem;
+    EXPECT_EQ(with_embree.t_mismatch, 0u) << with_embree.first_problem;
+  }
+}
+
+// The paper's global queue refuses, clearly, when the frame does not fit.
+TEST(PaperQueue, RefusesWhenTheQueueDoesNotFit) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  RenderSettings s = small_settings(Strategy::PaperQueue, 2048, 1024);
+  Film film(s.width, s.height, false);
+  RunReport r;
+  try {
+    render(scene, s, film, r, false);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    std::printf("[ INFO     ] refusal: %s\n", msg.c_str());
+    EXPECT_NE(msg.find("--spp"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("paper-queue"), std::string::npos) << msg;
+  }
+}
+
+TEST(GpuReport, HasDeviceFacts) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  RenderSettings s = small_settings(Strategy::Wavefront, 32, 8);
+  Film film(s.width, s.height, false);
+  RunReport r;
+  render(scene, s, film, r, true);
+  const auto j = r.to_json();
+  EXPECT_GT(j["device_seconds"].get<double>(), 0.0);
+  EXPECT_GT(j["peak_device_bytes"].get<uint64_t>(), 0u);
+  EXPECT_GT(j["state_bytes_per_path"].get<uint64_t>(), 0u);
+  EXPECT_FALSE(j["gpu"]["name"].get<std::string>().empty());
+  EXPECT_TRUE(j.contains("profile"));
+  EXPECT_GT(r.rays.shadow, 0u);
+  EXPECT_EQ(r.rays.camera, s.total_samples());
+}
+
+}  // namespace
+}  // namespace pb::gpu
