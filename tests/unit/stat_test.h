@@ -136,6 +136,11 @@ struct ImageTest {
   size_t zero_variance_failed = 0;
   double alpha = 0;           // per-value (Sidak-corrected) significance level
   double min_p = 1;
+  // Failures where our own sample variance is far below what the reference's
+  // per-sample variance predicts for our sample count: a rare, bright contribution
+  // (e.g. a sliver of the light in the pixel) that our few samples missed, so both
+  // our mean and our variance estimate are low. Reported to explain such failures.
+  size_t failed_undersampled = 0;
   double mean_ours[3] = {0, 0, 0};
   double mean_ref[3] = {0, 0, 0};
   double share_passed() const { return values ? double(passed) / double(values) : 0.0; }
@@ -144,7 +149,8 @@ struct ImageTest {
     std::ostringstream s;
     s << passed << " of " << values << " pixel-channels pass (" << 100.0 * share_passed()
       << " %) at Sidak-corrected alpha " << alpha << "; smallest p " << min_p << "; " << zero_variance
-      << " zero-variance values (" << zero_variance_failed << " differ); mean ratio R " << mean_ratio(0) << " G "
+      << " zero-variance values (" << zero_variance_failed << " differ); " << failed_undersampled
+      << " failures look under-sampled (our variance < 1/4 of the reference's, scaled to our spp); mean ratio R " << mean_ratio(0) << " G "
       << mean_ratio(1) << " B " << mean_ratio(2);
     return s.str();
   }
@@ -154,10 +160,12 @@ struct ImageTest {
 // with the Sidak-corrected level for `family_alpha` over all values. Where both
 // variances are (almost) zero -- a directly seen emitter, the same constant in every
 // sample -- the values must agree within `exact_tol` relative instead. Images are RGB
-// interleaved, variances are variances of the per-pixel mean.
+// interleaved, variances are variances of the per-pixel mean. `ref_over_ours_spp`
+// (reference samples / ours), when given, only sorts failures for the report.
 inline ImageTest compare_images(const std::vector<float>& ours, const std::vector<float>& var_ours,
                                 const std::vector<float>& ref, const std::vector<float>& var_ref,
-                                double family_alpha = 0.01, double exact_tol = 1e-4) {
+                                double family_alpha = 0.01, double exact_tol = 1e-4,
+                                double ref_over_ours_spp = 0) {
   ImageTest r;
   r.values = ours.size();
   r.alpha = sidak_alpha(family_alpha, double(r.values));
@@ -178,6 +186,7 @@ inline ImageTest compare_images(const std::vector<float>& ours, const std::vecto
     const double p = normal_two_sided_p((o - f) / std::sqrt(v));
     r.min_p = std::min(r.min_p, p);
     if (std::isfinite(o) && p >= r.alpha) ++r.passed;
+    else if (ref_over_ours_spp > 0 && var_ours[i] < 0.25 * var_ref[i] * ref_over_ours_spp) ++r.failed_undersampled;
   }
   const double n = double(ours.size() / 3);
   for (int c = 0; c < 3; ++c) {
