@@ -53,23 +53,20 @@ RenderCase render_case(const std::string& scene, Device dev, Strategy strat, uin
   return c;
 }
 
-void preset_quick() {
+// paper-cornell at the paper's two bounces, uniform (the paper's sampler) and nee,
+// every device and strategy; then Embree's ray casts on the same scene.
+void register_paper_cornell(uint32_t side, uint32_t spp, uint32_t raycast_side) {
   for (Device dev : devices())
     for (Sampling sampling : {Sampling::Uniform, Sampling::Nee})
       for (Strategy strat : strategies(dev))
-        register_render_benchmark(render_case("paper-cornell", dev, strat, 64, 64, 4, 2, sampling));
-  register_raycast_benchmarks({"paper-cornell", 128, 128});
+        register_render_benchmark(render_case("paper-cornell", dev, strat, side, side, spp, 2, sampling));
+  register_raycast_benchmarks({"paper-cornell", raycast_side, raycast_side});
   // GPU BVH ray casts (raycast/gpu/...) register here once the GPU tracer has them.
 }
 
-void preset_paper() {
-  for (Device dev : devices())
-    for (Sampling sampling : {Sampling::Uniform, Sampling::Nee})
-      for (Strategy strat : strategies(dev))
-        register_render_benchmark(render_case("paper-cornell", dev, strat, 256, 256, 800, 2, sampling));
-  register_raycast_benchmarks({"paper-cornell", 256, 256});
-  // GPU BVH ray casts (raycast/gpu/...) register here once the GPU tracer has them.
-}
+void preset_quick() { register_paper_cornell(64, 4, 128); }
+
+void preset_paper() { register_paper_cornell(256, 800, 256); }
 
 // Largest scaling scene; 10^7 needs several GB and about a minute per build on 2 cores.
 uint64_t scaling_max_triangles() {

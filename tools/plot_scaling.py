@@ -75,12 +75,30 @@ def load_rows(paths):
     return renders, raycasts, contexts
 
 
-def series_label(r):
-    return f"{r['device']} {r['strategy']}"
-
-
 def style(device):
     return "-" if device == "cpu" else "--"
+
+
+def by_series(rows, key):
+    """Rows grouped by (device, strategy), each group sorted by key."""
+    groups = defaultdict(list)
+    for r in rows:
+        groups[(r["device"], r["strategy"])].append(r)
+    return [(dev, strat, sorted(g, key=key)) for (dev, strat), g in sorted(groups.items())]
+
+
+def finish(fig, ax, xlabel, ylabel, title, out, legend_size=8):
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=legend_size)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+    print("wrote", out)
 
 
 def plot_rays_vs_triangles(renders, raycasts, out, title):
@@ -89,11 +107,7 @@ def plot_rays_vs_triangles(renders, raycasts, out, title):
         print("no scaling:N render rows; skipping", out)
         return
     fig, ax = plt.subplots(figsize=(8, 5.5))
-    groups = defaultdict(list)
-    for r in rows:
-        groups[(r["device"], r["strategy"])].append(r)
-    for (dev, strat), g in sorted(groups.items()):
-        g.sort(key=lambda r: r["triangles"])
+    for dev, strat, g in by_series(rows, lambda r: r["triangles"]):
         ax.plot([r["triangles"] for r in g], [r["rays_per_second"] for r in g], style(dev), marker="o",
                 label=f"path tracer: {dev} {strat}")
     rc = [r for r in raycasts if r["scene"].startswith("scaling:")]
@@ -105,18 +119,9 @@ def plot_rays_vs_triangles(renders, raycasts, out, title):
         g.sort(key=lambda r: r["triangles"])
         ax.plot([r["triangles"] for r in g], [r["rays_per_second"] for r in g], ":", marker=".", alpha=0.8,
                 label=f"raw ray cast: {dev} {api} {coh}")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("triangles")
-    ax.set_ylabel("rays per second")
     sizes = sorted({f"{r['w']}x{r['h']}" for r in rows})
-    ax.set_title(f"{title}\nrays/s vs scene size (scaling:N, nee, 2 bounces, {', '.join(sizes)}, 8 spp)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    print("wrote", out)
+    finish(fig, ax, "triangles", "rays per second",
+           f"{title}\nrays/s vs scene size (scaling:N, nee, 2 bounces, {', '.join(sizes)}, 8 spp)", out, 7)
 
 
 def plot_time_sweep(renders, out, title, key, xlabel, select):
@@ -125,23 +130,9 @@ def plot_time_sweep(renders, out, title, key, xlabel, select):
         print("no rows; skipping", out)
         return
     fig, ax = plt.subplots(figsize=(7, 5))
-    groups = defaultdict(list)
-    for r in rows:
-        groups[(r["device"], r["strategy"])].append(r)
-    for (dev, strat), g in sorted(groups.items()):
-        g.sort(key=key)
+    for dev, strat, g in by_series(rows, key):
         ax.plot([key(r) for r in g], [r["seconds"] for r in g], style(dev), marker="o", label=f"{dev} {strat}")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("render time (s)")
-    ax.set_title(title)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    print("wrote", out)
+    finish(fig, ax, xlabel, "render time (s)", title, out)
 
 
 def plot_memory(renders, out, title):
@@ -150,11 +141,7 @@ def plot_memory(renders, out, title):
         print("no rows; skipping", out)
         return
     fig, ax = plt.subplots(figsize=(8, 5.5))
-    groups = defaultdict(list)
-    for r in rows:
-        groups[(r["device"], r["strategy"])].append(r)
-    for (dev, strat), g in sorted(groups.items()):
-        g.sort(key=lambda r: r["pixels_x_spp"])
+    for dev, strat, g in by_series(rows, lambda r: r["pixels_x_spp"]):
         xs = [r["pixels_x_spp"] for r in g]
         if dev == "cpu":
             ax.plot(xs, [r["tracer_host_bytes"] for r in g], "-", marker="o",
@@ -169,17 +156,7 @@ def plot_memory(renders, out, title):
     lo = min(r["pixels_x_spp"] for r in rows)
     hi = max(r["pixels_x_spp"] for r in rows)
     ax.plot([lo, hi], [48 * lo, 48 * hi], "k--", alpha=0.5, label="paper's queue: 48 B x pixels x spp")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("pixels x spp")
-    ax.set_ylabel("bytes")
-    ax.set_title(title)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    print("wrote", out)
+    finish(fig, ax, "pixels x spp", "bytes", title, out, 7)
 
 
 def main():
@@ -190,15 +167,19 @@ def main():
     a = ap.parse_args()
     paths = list(a.json)
     if a.run:
-        machine = subprocess.run([a.run, "--preset", "quick", "--benchmark_filter=^$",
-                                  "--benchmark_format=json"], capture_output=True, text=True, check=True)
-        slug = json.loads(machine.stdout)["context"].get("machine", "unknown-machine")
+        # Runs into a temporary file, then files it under results/<machine>/ as named
+        # by the run's own context.
+        os.makedirs("results", exist_ok=True)
+        tmp = os.path.join("results", ".bench-scaling.tmp.json")
+        cmd = [a.run, "--preset", "scaling", f"--benchmark_out={tmp}", "--benchmark_out_format=json"]
+        print(" ".join(cmd), flush=True)
+        subprocess.run(cmd, check=True)
+        with open(tmp) as f:
+            slug = json.load(f)["context"].get("machine", "unknown-machine")
         out_dir = a.out_dir or os.path.join("results", slug)
         os.makedirs(out_dir, exist_ok=True)
         out_json = os.path.join(out_dir, "bench-scaling.json")
-        cmd = [a.run, "--preset", "scaling", f"--benchmark_out={out_json}", "--benchmark_out_format=json"]
-        print(" ".join(cmd), flush=True)
-        subprocess.run(cmd, check=True)
+        os.replace(tmp, out_json)
         paths.insert(0, out_json)
     if not paths:
         ap.error("give JSON files or --run")
