@@ -68,7 +68,9 @@ std::vector<std::string_view> split_ws(std::string_view line) {
   return out;
 }
 
+// The whole token as a number (from_chars, plus the leading '+' that OBJ writers use).
 template <class T> bool parse_whole(std::string_view tok, T& v) {
+  if (tok.size() > 1 && tok[0] == '+' && tok[1] != '-') tok.remove_prefix(1);
   auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
   return ec == std::errc() && ptr == tok.data() + tok.size();
 }
@@ -85,8 +87,8 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
   };
   std::vector<UsedMaterial> used;
   int64_t vertices = 0;
-  size_t bad_ref_line = 0;
-  int64_t bad_ref = 0;
+  int64_t max_ref = 0;  // the largest absolute vertex index, and its line
+  size_t max_ref_line = 0;
   size_t line_no = 0;
   for (size_t start = 0; start < text.size();) {
     size_t end = text.find('\n', start);
@@ -130,9 +132,9 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
           if (k < 0 && vertices + k < 0)
             fail(line_no, fmt::format("face vertex index {} reaches before the first vertex ({} read so far)", k,
                                       vertices));
-          if (k > 0 && bad_ref_line == 0 && k > vertices) {
-            bad_ref_line = line_no;
-            bad_ref = k;
+          if (k > max_ref) {
+            max_ref = k;
+            max_ref_line = line_no;
           }
         }
       }
@@ -147,8 +149,8 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
       }
     }
   }
-  if (bad_ref_line && bad_ref > vertices)
-    fail(bad_ref_line, fmt::format("face refers to vertex {}, but the file has only {} vertices", bad_ref, vertices));
+  if (max_ref > vertices)
+    fail(max_ref_line, fmt::format("face refers to vertex {}, but the file has only {} vertices", max_ref, vertices));
   return used;
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 
 namespace pb {
@@ -139,12 +140,23 @@ TEST_F(SceneObjFile, KdIsClampedAndKeEmits) {
   EXPECT_FLOAT_EQ(m.emission.z, 4.0f);
 }
 
-TEST_F(SceneObjFile, RelativeAndForwardIndicesWork) {
-  const std::string obj = write("r.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n");
+TEST_F(SceneObjFile, RelativeAndForwardIndicesAndPlusSignsWork) {
+  const std::string obj = write("r.obj", "f 1 2 3\nv 0 0 0\nv +1 0 0\nv 0 1.0e+0 0\nf -3 -2 -1\n");
   testing::internal::CaptureStderr();
   const Scene s = load_scene(obj);
   testing::internal::GetCapturedStderr();
   EXPECT_EQ(s.triangles.size(), 2u + 2);
+  EXPECT_EQ(s.positions[1].x, 1.0f);
+}
+
+TEST_F(SceneObjFile, TheLargestBadIndexIsReportedWithItsLine) {
+  const std::string obj = write("b.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+  try {
+    load_scene(obj);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.obj:5: face refers to vertex 9"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SceneFiles, ZeroAreaTrianglesAreDroppedWithAWarning) {
