@@ -238,7 +238,7 @@ class JsonSceneReader {
         what = what.substr(tag + 2);
       throw InputError(fmt::format("{}: malformed JSON: {}", path_, what));
     }
-    if (!root.is_object()) fail("", fmt::format("expected a JSON object at the top, got {}", root.type_name()));
+    if (!root.is_object()) fail("", "expected a JSON object at the top, got " + got(root));
     allow_keys(root, "", {"description", "camera", "materials", "meshes", "triangles"});
 
     Scene s;
@@ -249,8 +249,7 @@ class JsonSceneReader {
       fail("materials", "expected an object of named materials, e.g. {\"white\": {\"albedo\": [0.5, 0.5, 0.5]}}");
     for (const auto& [name, m] : materials.items()) {
       const std::string field = "materials." + name;
-      if (!m.is_object()) fail(field, fmt::format("expected an object, got {}", m.type_name()));
-      allow_keys(m, field, {"albedo", "emission"});
+      allow_keys(object(m, field), field, {"albedo", "emission"});
       const Vec3f albedo = m.contains("albedo") ? vec3(m["albedo"], field + ".albedo") : Vec3f{0, 0, 0};
       const Vec3f emission = m.contains("emission") ? vec3(m["emission"], field + ".emission") : Vec3f{0, 0, 0};
       scenes::add_material(s, name, albedo, emission);
@@ -291,24 +290,34 @@ class JsonSceneReader {
       }
     }
   }
+  // What a value is, for messages: a scalar as written (shortened), a container by kind.
+  static std::string got(const Json& j) {
+    if (j.is_array()) return fmt::format("an array of {} element{}", j.size(), j.size() == 1 ? "" : "s");
+    if (j.is_object()) return "an object";
+    std::string text = j.dump();
+    if (text.size() > 40) text = text.substr(0, 37) + "...";
+    return fmt::format("{} {}", j.type_name(), text);
+  }
   const Json& array(const Json& j, const std::string& field) const {
-    if (!j.is_array()) fail(field, fmt::format("expected an array, got {}", j.type_name()));
+    if (!j.is_array()) fail(field, "expected an array, got " + got(j));
+    return j;
+  }
+  const Json& object(const Json& j, const std::string& field) const {
+    if (!j.is_object()) fail(field, "expected an object, got " + got(j));
     return j;
   }
   float number(const Json& j, const std::string& field) const {
-    if (!j.is_number()) fail(field, fmt::format("expected a number, got {}", j.type_name()));
+    if (!j.is_number()) fail(field, "expected a number, got " + got(j));
     const double v = j.get<double>();
     if (!std::isfinite(float(v))) fail(field, fmt::format("{} is not a finite number (or too large for a float)", v));
     return float(v);
   }
   Vec3f vec3(const Json& j, const std::string& field) const {
-    if (!j.is_array() || j.size() != 3)
-      fail(field, fmt::format("expected an array of 3 numbers, got {}", j.is_array() ? fmt::format("{} elements", j.size())
-                                                                                    : std::string(j.type_name())));
+    if (!j.is_array() || j.size() != 3) fail(field, "expected an array of 3 numbers, got " + got(j));
     return {number(j[0], field + "[0]"), number(j[1], field + "[1]"), number(j[2], field + "[2]")};
   }
   std::string string(const Json& j, const std::string& field) const {
-    if (!j.is_string()) fail(field, fmt::format("expected a string, got {}", j.type_name()));
+    if (!j.is_string()) fail(field, "expected a string, got " + got(j));
     return j.get<std::string>();
   }
   uint32_t material(const Scene& s, const Json& j, const std::string& field) const {
@@ -321,8 +330,7 @@ class JsonSceneReader {
   }
 
   void read_camera(Scene& s, const Json& cam) const {
-    if (!cam.is_object()) fail("camera", fmt::format("expected an object, got {}", cam.type_name()));
-    allow_keys(cam, "camera", {"position", "look_at", "up", "fov_y_deg"});
+    allow_keys(object(cam, "camera"), "camera", {"position", "look_at", "up", "fov_y_deg"});
     const Vec3f eye = vec3(member(cam, "position", "camera"), "camera.position");
     const Vec3f target = vec3(member(cam, "look_at", "camera"), "camera.look_at");
     const Vec3f up = cam.contains("up") ? vec3(cam["up"], "camera.up") : Vec3f{0, 1, 0};
@@ -335,16 +343,14 @@ class JsonSceneReader {
   }
 
   void read_mesh(Scene& s, const Json& m, const std::string& field) const {
-    if (!m.is_object()) fail(field, fmt::format("expected an object, got {}", m.type_name()));
-    allow_keys(m, field, {"file", "material", "transform"});
+    allow_keys(object(m, field), field, {"file", "material", "transform"});
     const std::string file = string(member(m, "file", field), field + ".file");
     const uint32_t mat = material(s, member(m, "material", field), field + ".material");
     Vec3f scale{1, 1, 1}, translate{0, 0, 0};
     if (m.contains("transform")) {
       const Json& t = m["transform"];
       const std::string tf = field + ".transform";
-      if (!t.is_object()) fail(tf, fmt::format("expected an object, got {}", t.type_name()));
-      allow_keys(t, tf, {"scale", "translate"});
+      allow_keys(object(t, tf), tf, {"scale", "translate"});
       if (t.contains("scale")) {
         const Json& sc = t["scale"];
         scale = sc.is_array() ? vec3(sc, tf + ".scale") : Vec3f{1, 1, 1} * number(sc, tf + ".scale");
@@ -366,8 +372,7 @@ class JsonSceneReader {
   }
 
   void read_triangles(Scene& s, const Json& g, const std::string& field) const {
-    if (!g.is_object()) fail(field, fmt::format("expected an object, got {}", g.type_name()));
-    allow_keys(g, field, {"vertices", "indices", "material"});
+    allow_keys(object(g, field), field, {"vertices", "indices", "material"});
     const Json& vertices = array(member(g, "vertices", field), field + ".vertices");
     const Json& indices = array(member(g, "indices", field), field + ".indices");
     const uint32_t mat = material(s, member(g, "material", field), field + ".material");
@@ -377,12 +382,12 @@ class JsonSceneReader {
     for (size_t i = 0; i < indices.size(); ++i) {
       const std::string tf = fmt::format("{}.indices[{}]", field, i);
       const Json& t = indices[i];
-      if (!t.is_array() || t.size() != 3) fail(tf, "expected an array of 3 vertex indices");
+      if (!t.is_array() || t.size() != 3) fail(tf, "expected an array of 3 vertex indices, got " + got(t));
       uint32_t v[3];
       for (int k = 0; k < 3; ++k) {
         const std::string kf = fmt::format("{}[{}]", tf, k);
         if (!t[k].is_number_integer())
-          fail(kf, fmt::format("expected a vertex index (a whole number), got {}", t[k].type_name()));
+          fail(kf, "expected a vertex index (a whole number), got " + got(t[k]));
         const int64_t idx = t[k].get<int64_t>();
         if (idx < 0 || uint64_t(idx) >= vertices.size())
           fail(kf, fmt::format("vertex index {} is out of range (this group has {} vertices, 0 to {})", idx,
