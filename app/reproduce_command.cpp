@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
@@ -31,16 +32,60 @@ std::string fmt_bytes(double b) {
 double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
 
 uint64_t queue_bytes(const RunReport& r) {
-  for (const char* key : {"queue_bytes", "pool_bytes"})
+  for (const char* key : {"queue_bytes", "pool_bytes", "pool_device_bytes"})
     if (r.extra.contains(key) && r.extra[key].is_number()) return r.extra[key].get<uint64_t>();
   return 0;
 }
 
 std::string device_label(const RunReport& r) {
   if (r.settings.device == Device::Cpu) return fmt::format("CPU, {} threads", r.threads);
-  if (r.extra.contains("gpu_name") && r.extra["gpu_name"].is_string())
-    return fmt::format("GPU ({})", r.extra["gpu_name"].get<std::string>());
+  if (r.extra.contains("gpu") && r.extra["gpu"].contains("name") && r.extra["gpu"]["name"].is_string())
+    return fmt::format("GPU ({})", r.extra["gpu"]["name"].get<std::string>());
   return "GPU";
+}
+
+RenderSettings paper_settings(Device dev, Strategy strategy, Sampling sampling, uint32_t spp, int threads) {
+  RenderSettings s;
+  s.width = s.height = kSide;
+  s.spp = spp;
+  s.max_bounces = 2;
+  s.sampling = sampling;
+  s.strategy = strategy;
+  s.device = dev;
+  s.threads = threads;
+  return s;
+}
+
+// Seconds per sample per pixel of a CPU pixel-parallel render with `sampling`,
+// measured on a short render.
+double cpu_seconds_per_spp(const Scene& scene, Sampling sampling, int threads) {
+  constexpr uint32_t kProbeSpp = 8;
+  RenderSettings s = paper_settings(Device::Cpu, Strategy::Pixel, sampling, kProbeSpp, threads);
+  s.progress = false;
+  Film film(s.width, s.height, false);
+  RunReport r;
+  render_on_device(scene, s, film, r, false);
+  return r.seconds / kProbeSpp;
+}
+
+// Samples per pixel for the CPU rows other than pixel/nee (which makes the image
+// and always runs at `spp`): `spp`, unless the four CPU rows would overrun
+// `budget_s`; then as many as fit in what the image row leaves (a multiple of 16, at
+// least 16). Their times are scaled to `spp` in the table.
+uint32_t reduced_spp_for_budget(const Scene& scene, uint32_t spp, double budget_s, int threads) {
+  if (budget_s <= 0) return spp;
+  const double uni = cpu_seconds_per_spp(scene, Sampling::Uniform, threads);
+  const double nee = cpu_seconds_per_spp(scene, Sampling::Nee, threads);
+  const double full = 2 * spp * (uni + nee);
+  if (full <= budget_s) return spp;
+  const double left = budget_s - spp * nee;  // after the image row
+  uint32_t r = left > 0 ? uint32_t(left / (2 * uni + nee)) / 16 * 16 : 0;
+  r = std::clamp<uint32_t>(r, 16, spp);
+  fmt::print("reproduce: all CPU rows at {} spp would take about {:.0f} s here (budget {:.0f} s); the image row "
+             "(pixel, nee) runs at {} spp, the other CPU rows at {} spp with times scaled to {} spp "
+             "(--budget 0 for full spp everywhere)\n",
+             spp, full, budget_s, spp, r, spp);
+  return r;
 }
 
 }  // namespace
@@ -50,7 +95,11 @@ void add_reproduce_options(CLI::App& cmd, ReproduceOptions& o) {
   cmd.add_option("--out-dir", o.out_dir, "where to write images, reports and the table (default results/<machine>)");
   cmd.add_option("--spp", o.spp, "samples per pixel (the paper: 800)")->capture_default_str();
   cmd.add_option("--uniform-spp", o.uniform_spp,
-                 "samples per pixel for the uniform rows (0: --spp); their times are scaled to --spp in the table");
+                 "samples per pixel for the CPU uniform rows (0: --spp, or fewer if --budget needs it); times are scaled to --spp in the table");
+  cmd.add_option("--budget", o.budget_s,
+                 "seconds the CPU rows may take: if the full run would not fit, every CPU row but the image row "
+                 "(pixel, nee) runs at fewer spp and its time is scaled; 0: no budget")
+      ->capture_default_str();
   cmd.add_option("--threads", o.threads, "CPU threads (0: all)")->capture_default_str();
   cmd.add_flag("--quiet", o.quiet, "no progress bars");
 }
@@ -59,7 +108,6 @@ int run_reproduce(const ReproduceOptions& o) {
   if (o.device != "cpu" && o.device != "gpu" && o.device != "all")
     throw InputError(fmt::format("--device: unknown device '{}' (expected cpu, gpu or all)", o.device));
   if (o.spp == 0) throw InputError("--spp: must be at least 1");
-  const uint32_t uniform_spp = o.uniform_spp ? o.uniform_spp : o.spp;
   std::vector<Device> devices;
   std::string why_no_gpu;
   const bool have_gpu = gpu_available(&why_no_gpu);
@@ -70,6 +118,10 @@ int run_reproduce(const ReproduceOptions& o) {
   const std::string dir = o.out_dir.empty() ? "results/" + machine_slug() : o.out_dir;
   const Scene scene = make_paper_cornell();
   const auto t_start = std::chrono::steady_clock::now();
+  const bool cpu_rows = devices.front() == Device::Cpu;
+  // CPU rows other than the image row (pixel, nee) may run at fewer spp.
+  const uint32_t reduced_spp = cpu_rows ? reduced_spp_for_budget(scene, o.spp, o.budget_s, o.threads) : o.spp;
+  const uint32_t uniform_spp = o.uniform_spp ? o.uniform_spp : reduced_spp;
   std::vector<RunReport> rows;
   nlohmann::json all = nlohmann::json::array();
   for (Device dev : devices) {
@@ -77,14 +129,10 @@ int run_reproduce(const ReproduceOptions& o) {
     if (dev == Device::Gpu) strategies.push_back(Strategy::PaperQueue);
     for (Sampling sampling : {Sampling::Uniform, Sampling::Nee}) {
       for (Strategy strategy : strategies) {
-        RenderSettings s;
-        s.width = s.height = kSide;
-        s.spp = sampling == Sampling::Uniform ? uniform_spp : o.spp;
-        s.max_bounces = 2;
-        s.sampling = sampling;
-        s.strategy = strategy;
-        s.device = dev;
-        s.threads = o.threads;
+        uint32_t spp = o.spp;
+        if (dev == Device::Cpu && sampling == Sampling::Uniform) spp = uniform_spp;
+        if (dev == Device::Cpu && sampling == Sampling::Nee && strategy != Strategy::Pixel) spp = reduced_spp;
+        RenderSettings s = paper_settings(dev, strategy, sampling, spp, o.threads);
         s.progress = !o.quiet;
         Film film(s.width, s.height, false);
         RunReport r;
@@ -165,8 +213,9 @@ int run_reproduce(const ReproduceOptions& o) {
   md += "- \"queue or pool\": bytes of path state held at once (CPU/GPU wavefront: the bounded pool of paths in flight; "
         "paper-queue: the whole frame's queue); pixel-parallel keeps one path per thread.\n";
   if (scaled)
-    md += fmt::format("- Rows marked (scaled) ran at fewer spp to keep `pathbench reproduce` short; their time at {} spp "
-                      "is the measured time x {} / spp run (render time is linear in spp).\n",
+    md += fmt::format("- Rows marked (scaled) ran at fewer spp to keep `pathbench reproduce` within its time budget "
+                      "(--budget); their time at {} spp is the measured time x {} / spp run (render time is linear "
+                      "in spp).\n",
                       o.spp, o.spp);
   md += fmt::format("- CPU: {} ({} hardware threads). Git revision {}. Whole run: {:.1f} s wall.\n", cpu_model(),
                     hardware_threads(), git_revision(), wall);

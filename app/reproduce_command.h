@@ -15,7 +15,9 @@ struct ReproduceOptions {
   std::string device = "all";   // cpu, gpu or all (= cpu, plus gpu when present)
   std::string out_dir;          // default results/<machine>
   uint32_t spp = 800;
-  uint32_t uniform_spp = 0;     // spp of the uniform rows; 0 = spp (times are scaled to spp in the table)
+  uint32_t uniform_spp = 0;     // spp of the CPU uniform rows; 0 = spp, or fewer if the budget needs it
+  double budget_s = 100;        // seconds for the CPU rows; over it, all CPU rows but the image row
+                                // (pixel, nee) run at fewer spp, scaled in the table; 0 = no budget
   int threads = 0;
   bool quiet = false;
 };

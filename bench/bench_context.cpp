@@ -13,7 +13,7 @@
 #include "pathbench/common/report.h"
 
 #if PATHBENCH_BENCH_GPU
-#include <cuda_runtime_api.h>
+#include "pathbench/gpu/render.h"
 #endif
 
 namespace pb::bench {
@@ -38,24 +38,20 @@ void add(const char* key, const std::string& value) { benchmark::AddCustomContex
 
 void add_gpu_context() {
 #if PATHBENCH_BENCH_GPU
-  int count = 0;
-  if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) {
-    add("gpu", "none (no CUDA device)");
+  std::string why;
+  if (!gpu::device_available(&why)) {
+    add("gpu", "none: " + why);
     return;
   }
-  cudaDeviceProp prop{};
-  cudaGetDeviceProperties(&prop, 0);
-  int driver = 0, runtime = 0;
-  cudaDriverGetVersion(&driver);
-  cudaRuntimeGetVersion(&runtime);
-  add("gpu_name", prop.name);
-  add("gpu_count", std::to_string(count));
-  add("gpu_compute_capability", fmt::format("{}.{}", prop.major, prop.minor));
-  add("gpu_memory_bytes", std::to_string(prop.totalGlobalMem));
-  add("cuda_driver_api", fmt::format("{}.{}", driver / 1000, (driver % 1000) / 10));
-  add("cuda_runtime", fmt::format("{}.{}", runtime / 1000, (runtime % 1000) / 10));
-  const std::string nv = first_line("/proc/driver/nvidia/version");
-  if (!nv.empty()) add("gpu_driver", nv);
+  const gpu::DeviceInfo info = gpu::device_info();
+  add("gpu_name", info.name);
+  add("gpu_compute_capability", fmt::format("{}.{}", info.compute_major, info.compute_minor));
+  add("gpu_multiprocessors", std::to_string(info.multiprocessors));
+  add("gpu_memory_bytes", std::to_string(info.total_memory));
+  add("cuda_driver_api", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10));
+  add("cuda_runtime", fmt::format("{}.{}", info.runtime_version / 1000, (info.runtime_version % 1000) / 10));
+  const std::string nv = first_line("/proc/driver/nvidia/version");  // the kernel driver's own version line
+  add("gpu_driver", nv.empty() ? "unknown" : nv);
 #else
   add("gpu", "none (built without the CUDA tracer)");
 #endif

@@ -25,7 +25,8 @@ void reset_peak_rss() {
 
 uint64_t queue_bytes_of(const RunReport& r) {
   if (r.settings.strategy == Strategy::Pixel) return 0;
-  for (const char* key : {"queue_bytes", "pool_bytes"})
+  // CPU wavefront: pool_bytes; GPU wavefront and paper-queue: pool_device_bytes.
+  for (const char* key : {"queue_bytes", "pool_bytes", "pool_device_bytes"})
     if (r.extra.contains(key) && r.extra[key].is_number()) return r.extra[key].get<uint64_t>();
   return 0;
 }

@@ -141,17 +141,24 @@ def plot_memory(renders, out, title):
         print("no rows; skipping", out)
         return
     fig, ax = plt.subplots(figsize=(8, 5.5))
+    sweeps = [("spp sweep, 128x128", "o", lambda r: r["w"] == 128 and r["h"] == 128),
+              ("resolution sweep, 16 spp", "s", lambda r: r["spp"] == 16)]
+    for sweep, marker, select in sweeps:
+        for dev, strat, g in by_series([r for r in rows if select(r)], lambda r: r["pixels_x_spp"]):
+            xs = [r["pixels_x_spp"] for r in g]
+            if dev == "cpu":
+                ax.plot(xs, [r["tracer_host_bytes"] for r in g], "-", marker=marker,
+                        label=f"{dev} {strat}, {sweep}: film + pool + BVH")
+            else:
+                ax.plot(xs, [r["peak_device_bytes"] for r in g], "--", marker=marker,
+                        label=f"{dev} {strat}, {sweep}: device peak")
     for dev, strat, g in by_series(rows, lambda r: r["pixels_x_spp"]):
-        xs = [r["pixels_x_spp"] for r in g]
-        if dev == "cpu":
-            ax.plot(xs, [r["tracer_host_bytes"] for r in g], "-", marker="o",
-                    label=f"{dev} {strat}: tracer's own memory (film + pool + BVH)")
-            ax.plot(xs, [r["queue_bytes"] or float("nan") for r in g], "-.", marker="x",
-                    label=f"{dev} {strat}: path queue / pool")
-            ax.plot(xs, [r["peak_host_bytes"] for r in g], ":", marker=".", alpha=0.6,
-                    label=f"{dev} {strat}: process peak RSS")
-        else:
-            ax.plot(xs, [r["peak_device_bytes"] for r in g], "--", marker="o", label=f"{dev} {strat}: device peak")
+        if strat != "pixel":
+            ax.plot([r["pixels_x_spp"] for r in g], [r["queue_bytes"] for r in g], ":", marker="x",
+                    label=f"{dev} {strat}: path pool / queue alone")
+        if dev == "cpu" and strat == "pixel":
+            ax.plot([r["pixels_x_spp"] for r in g], [r["peak_host_bytes"] for r in g], ":", color="grey",
+                    label="cpu: process peak RSS (program + scene + tracer)")
     # The paper's queue: one 48-byte task per sample of the frame.
     lo = min(r["pixels_x_spp"] for r in rows)
     hi = max(r["pixels_x_spp"] for r in rows)
