@@ -169,37 +169,38 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
 }
 
 // ---------------------------------------------------------------------------------
-// wavefront and paper-queue: path state as structure of arrays for `capacity` paths,
-// stage kernels linked by queues. Each stage kernel loops over a count it reads on
-// the device, so the host never waits between stages.
+// wavefront and paper-queue: a pool of `capacity` paths in flight as structure of
+// arrays, stage kernels linked by queues. Paths that continue are compacted into the
+// other of two state buffers (warp-aggregated atomic append), new samples are appended
+// after them, so every stage reads its paths contiguously. Each stage kernel loops over
+// a count it reads on the device: the host never waits between stages.
 
-struct QueueCounters {
-  uint32_t ray[2];        // ray queues: [cur] this iteration, [cur ^ 1] next
-  uint32_t shadow, done, free;
-  uint32_t gen_count, gen_free_base, gen_ray_base;
-  uint32_t live;          // paths to intersect this iteration (0: frame finished)
-  uint32_t pad;
-  unsigned long long next_sample, gen_base;
-  Stats stats;
-};
-
-struct Pool {
-  // Path state. Only what the scene and estimator need: the shadow arrays and their
-  // queue exist only with light sampling on a scene with emitters.
+struct PathSoA {
   float4* o;        // ray origin, bsdf_pdf
   float4* d;        // ray direction, pixel (bits)
   float4* beta;     // throughput, depth (bits)
-  float4* L;        // radiance, hit triangle (bits; written by intersect)
+  float4* L;        // radiance so far (w unused)
   uint32_t* sample;
-  float4* sh_o;     // shadow origin, contribution.x
-  float4* sh_d;     // shadow direction, contribution.y
-  float* sh_c;      // contribution.z
-  uint32_t* ray_q[2];
-  uint32_t* shadow_q;
-  uint32_t* done_q;
-  uint32_t* free_q;
-  QueueCounters* ctr;
-  uint32_t capacity;
+};
+
+// Shadow rays of one iteration. `target`: index of the continuing path in the next
+// buffer, or kShadowDone | pixel for a path that ended (its radiance is in L).
+struct ShadowSoA {
+  float4* o;        // origin, contribution.x
+  float4* d;        // direction (unnormalised, to the light point), contribution.y
+  float4* L;        // radiance of a finished path, contribution.z
+  uint32_t* target;
+};
+constexpr uint32_t kShadowDone = 0x80000000u;  // pixels < 2^31 (RenderSettings::validate)
+
+struct WaveCounters {
+  uint32_t n_cur;      // paths to trace this iteration
+  uint32_t n_next;     // paths continued into the next buffer
+  uint32_t n_shadow;   // shadow rays queued this iteration
+  uint32_t gen_count, gen_dst;
+  uint32_t live;       // == n_cur after scheduling; 0: the frame is done
+  unsigned long long next_sample, gen_base;
+  Stats stats;
 };
 
 __device__ __forceinline__ uint32_t grid_thread() { return blockIdx.x * blockDim.x + threadIdx.x; }
@@ -216,8 +217,27 @@ __device__ __forceinline__ uint32_t queue_push(uint32_t* counter) {
   return base + uint32_t(__popc(mask & ((1u << lane) - 1u)));
 }
 
-__device__ __forceinline__ PathState<float> load_state(const Pool& p, uint32_t slot, uint32_t& prim) {
-  const float4 o = p.o[slot], d = p.d[slot], b = p.beta[slot], L = p.L[slot];
+template <bool kVariance>
+__device__ __forceinline__ void film_add(const FilmDev& film, uint32_t pixel, const Vec3f& L, Stats* stats) {
+  if (!sample_acceptable(L, film.limit)) {
+    atomicAdd(&stats->discarded, 1ull);
+    return;
+  }
+  unsigned long long* sum = film.sum + size_t(pixel) * 3;
+  atomicAdd(sum + 0, static_cast<unsigned long long>(quantize_radiance(L.x, film.scale)));
+  atomicAdd(sum + 1, static_cast<unsigned long long>(quantize_radiance(L.y, film.scale)));
+  atomicAdd(sum + 2, static_cast<unsigned long long>(quantize_radiance(L.z, film.scale)));
+  atomicAdd(film.count + pixel, 1u);
+  if (kVariance) {
+    double* sq = film.sum_sq + size_t(pixel) * 3;
+    atomicAdd(sq + 0, double(L.x) * double(L.x));
+    atomicAdd(sq + 1, double(L.y) * double(L.y));
+    atomicAdd(sq + 2, double(L.z) * double(L.z));
+  }
+}
+
+__device__ __forceinline__ PathState<float> load_path(const PathSoA& p, uint32_t i) {
+  const float4 o = p.o[i], d = p.d[i], b = p.beta[i], L = p.L[i];
   PathState<float> st;
   st.ray.o = {o.x, o.y, o.z};
   st.bsdf_pdf = o.w;
@@ -226,138 +246,111 @@ __device__ __forceinline__ PathState<float> load_state(const Pool& p, uint32_t s
   st.beta = {b.x, b.y, b.z};
   st.depth = __float_as_uint(b.w);
   st.L = {L.x, L.y, L.z};
-  prim = __float_as_uint(L.w);
-  st.sample = p.sample[slot];
+  st.sample = p.sample[i];
   return st;
 }
 
-__device__ __forceinline__ void store_state(const Pool& p, uint32_t slot, const PathState<float>& st) {
-  p.o[slot] = make_float4(st.ray.o.x, st.ray.o.y, st.ray.o.z, st.bsdf_pdf);
-  p.d[slot] = make_float4(st.ray.d.x, st.ray.d.y, st.ray.d.z, __uint_as_float(st.pixel));
-  p.beta[slot] = make_float4(st.beta.x, st.beta.y, st.beta.z, __uint_as_float(st.depth));
-  p.L[slot] = make_float4(st.L.x, st.L.y, st.L.z, __uint_as_float(kNoHit));
+__device__ __forceinline__ void store_path(const PathSoA& p, uint32_t i, const PathState<float>& st) {
+  p.o[i] = make_float4(st.ray.o.x, st.ray.o.y, st.ray.o.z, st.bsdf_pdf);
+  p.d[i] = make_float4(st.ray.d.x, st.ray.d.y, st.ray.d.z, __uint_as_float(st.pixel));
+  p.beta[i] = make_float4(st.beta.x, st.beta.y, st.beta.z, __uint_as_float(st.depth));
+  p.L[i] = make_float4(st.L.x, st.L.y, st.L.z, 0.0f);
+  p.sample[i] = st.sample;
 }
 
-__global__ void k_pool_init(Pool p) {
-  for (uint32_t i = grid_thread(); i < p.capacity; i += grid_threads()) p.free_q[i] = i;
-  if (grid_thread() == 0) {
-    QueueCounters z{};
-    z.free = p.capacity;
-    *p.ctr = z;
-  }
-}
-
-// One thread: books the previous iteration's counts and plans this one's refill.
-__global__ void k_schedule(Pool p, uint32_t cur, unsigned long long total) {
+// One thread: books the last iteration and plans this one's refill.
+__global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint32_t capacity) {
   if (grid_thread() != 0) return;
-  QueueCounters& c = *p.ctr;
-  c.stats.bounce += c.ray[cur];  // paths that continued from the last shade
-  c.stats.shadow += c.shadow;
-  c.stats.paths += c.done;
+  WaveCounters& c = *ctr;
+  const uint32_t cont = c.n_next;  // paths that continued from the last shade
+  c.stats.bounce += cont;
+  c.stats.shadow += c.n_shadow;
   const unsigned long long remaining = total - c.next_sample;
-  const uint32_t n = uint32_t(remaining < c.free ? remaining : c.free);
+  const uint32_t room = capacity - cont;
+  const uint32_t n = uint32_t(remaining < room ? remaining : room);
   c.gen_count = n;
+  c.gen_dst = cont;
   c.gen_base = c.next_sample;
-  c.gen_free_base = c.free - n;
-  c.gen_ray_base = c.ray[cur];
-  c.free -= n;
   c.next_sample += n;
-  c.ray[cur] += n;
   c.stats.camera += n;
-  c.ray[cur ^ 1] = 0;
-  c.shadow = 0;
-  c.done = 0;
-  c.live = c.ray[cur];
+  c.n_cur = cont + n;
+  c.n_next = 0;
+  c.n_shadow = 0;
+  c.live = c.n_cur;
 }
 
-__global__ void k_generate(SceneView s, PathConfig c, Pool p, uint32_t cur, uint32_t pixels) {
-  const QueueCounters& q = *p.ctr;
-  const uint32_t n = q.gen_count;
+// New samples after the continuing paths; a warp takes consecutive samples of a pixel,
+// as the pixel strategy does (coherent camera rays).
+__global__ void k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const WaveCounters* ctr, uint32_t spp) {
+  const uint32_t n = ctr->gen_count, dst = ctr->gen_dst;
+  const unsigned long long base = ctr->gen_base;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const uint32_t slot = p.free_q[q.gen_free_base + i];
-    const unsigned long long g = q.gen_base + i;
+    const unsigned long long g = base + i;
     PathState<float> st;
-    path_begin(s, c, uint32_t(g % pixels), uint32_t(g / pixels), st);
-    store_state(p, slot, st);
-    p.sample[slot] = st.sample;
-    p.ray_q[cur][q.gen_ray_base + i] = slot;
+    path_begin(s, c, uint32_t(g / spp), uint32_t(g % spp), st);
+    store_path(cur, dst + i, st);
   }
 }
 
-__global__ void k_intersect(BvhView bvh, Pool p, uint32_t cur) {
-  const uint32_t n = p.ctr->ray[cur];
+__global__ void k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+  const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const uint32_t slot = p.ray_q[cur][i];
-    const float4 o = p.o[slot], d = p.d[slot];
+    const float4 o = cur.o[i], d = cur.d[i];
     float t;
-    const uint32_t prim = intersect_closest(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
-    reinterpret_cast<float*>(p.L + slot)[3] = __uint_as_float(prim);
+    prim[i] = intersect_closest(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
   }
 }
 
-__global__ void k_shade(SceneView s, PathConfig c, Pool p, uint32_t cur) {
-  const uint32_t n = p.ctr->ray[cur];
+template <bool kVariance>
+__global__ void k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next, const uint32_t* prim, ShadowSoA sh,
+                           WaveCounters* ctr, FilmDev film) {
+  const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const uint32_t slot = p.ray_q[cur][i];
-    uint32_t prim;
-    PathState<float> st = load_state(p, slot, prim);
-    if (prim == kNoHit) {
-      p.done_q[queue_push(&p.ctr->done)] = slot;
+    PathState<float> st = load_path(cur, i);
+    const uint32_t h = prim[i];
+    if (h == kNoHit) {
+      film_add<kVariance>(film, st.pixel, st.L, &ctr->stats);
       continue;
     }
     ShadowQuery<float> q;
     bool wants_shadow;
-    const PathEvent ev = path_hit(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
-    store_state(p, slot, st);
+    const PathEvent ev = path_hit(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+    uint32_t target = kShadowDone | st.pixel;
+    if (ev == PathEvent::Continue) {
+      const uint32_t j = queue_push(&ctr->n_next);
+      store_path(next, j, st);
+      target = j;
+    }
     if (wants_shadow) {
-      p.sh_o[slot] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
-      p.sh_d[slot] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
-      p.sh_c[slot] = q.contribution.z;
-      p.shadow_q[queue_push(&p.ctr->shadow)] = slot;
+      const uint32_t k = queue_push(&ctr->n_shadow);
+      sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
+      sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
+      sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, q.contribution.z);
+      sh.target[k] = target;
+    } else if (ev == PathEvent::Done) {
+      film_add<kVariance>(film, st.pixel, st.L, &ctr->stats);
     }
-    if (ev == PathEvent::Continue) p.ray_q[cur ^ 1][queue_push(&p.ctr->ray[cur ^ 1])] = slot;
-    else p.done_q[queue_push(&p.ctr->done)] = slot;
   }
 }
 
-__global__ void k_shadow(BvhView bvh, Pool p) {
-  const uint32_t n = p.ctr->shadow;
+template <bool kVariance>
+__global__ void k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr, FilmDev film) {
+  const uint32_t n = ctr->n_shadow;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const uint32_t slot = p.shadow_q[i];
-    const float4 o = p.sh_o[slot], d = p.sh_d[slot];
-    if (!occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f)) {
-      float4 L = p.L[slot];
-      L.x = L.x + o.w;  // shadow_unoccluded: L += contribution
+    const float4 o = sh.o[i], d = sh.d[i], l = sh.L[i];
+    const uint32_t target = sh.target[i];
+    const bool visible = !occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f);
+    if (target & kShadowDone) {
+      Vec3f L{l.x, l.y, l.z};
+      if (visible) L = L + Vec3f{o.w, d.w, l.w};  // shadow_unoccluded: L += contribution
+      film_add<kVariance>(film, target & ~kShadowDone, L, &ctr->stats);
+    } else if (visible) {
+      float4 L = next.L[target];
+      L.x = L.x + o.w;
       L.y = L.y + d.w;
-      L.z = L.z + p.sh_c[slot];
-      p.L[slot] = L;
+      L.z = L.z + l.w;
+      next.L[target] = L;
     }
-  }
-}
-
-template <bool kVariance> __global__ void k_accumulate(Pool p, FilmDev film) {
-  const uint32_t n = p.ctr->done;
-  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const uint32_t slot = p.done_q[i];
-    const float4 L4 = p.L[slot];
-    const Vec3f L{L4.x, L4.y, L4.z};
-    const uint32_t pixel = __float_as_uint(p.d[slot].w);
-    if (sample_acceptable(L, film.limit)) {
-      unsigned long long* sum = film.sum + size_t(pixel) * 3;
-      atomicAdd(sum + 0, static_cast<unsigned long long>(quantize_radiance(L.x, film.scale)));
-      atomicAdd(sum + 1, static_cast<unsigned long long>(quantize_radiance(L.y, film.scale)));
-      atomicAdd(sum + 2, static_cast<unsigned long long>(quantize_radiance(L.z, film.scale)));
-      atomicAdd(film.count + pixel, 1u);
-      if (kVariance) {
-        double* sq = film.sum_sq + size_t(pixel) * 3;
-        atomicAdd(sq + 0, double(L.x) * double(L.x));
-        atomicAdd(sq + 1, double(L.y) * double(L.y));
-        atomicAdd(sq + 2, double(L.z) * double(L.z));
-      }
-    } else {
-      atomicAdd(&p.ctr->stats.discarded, 1ull);
-    }
-    p.free_q[queue_push(&p.ctr->free)] = slot;
   }
 }
 
@@ -450,9 +443,10 @@ uint64_t default_paths_in_flight() {
   const DeviceInfo info = device_info();
   int threads_per_sm = 0;
   PB_CUDA_CHECK(cudaDeviceGetAttribute(&threads_per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, info.device));
-  // Eight full waves of threads: enough paths for every stage to fill the device
-  // (about 2.2 million on an H100), at ~120 bytes a path well under 512 MB.
-  return uint64_t(info.multiprocessors) * uint64_t(threads_per_sm) * 8;
+  // Five full waves of threads: enough paths for every stage to fill the device
+  // (about 1.35 million on an H100); at 192 bytes a path (with light sampling) the pool
+  // takes ~260 MB, which leaves room for a 2048x2048 film under 512 MB.
+  return uint64_t(info.multiprocessors) * uint64_t(threads_per_sm) * 5;
 }
 
 // -----------------------------------------------------------------------------------
@@ -550,63 +544,48 @@ struct FrameResult {
 class PathPool {
  public:
   PathPool(uint64_t capacity, bool shadows, const char* what, const char* lower) : capacity_(capacity), shadows_(shadows) {
-    o.allocate(capacity, what, lower);
-    d.allocate(capacity, what, lower);
-    beta.allocate(capacity, what, lower);
-    L.allocate(capacity, what, lower);
-    sample.allocate(capacity, what, lower);
+    for (auto& b : buf_) b.allocate(capacity, what, lower);
+    prim_.allocate(capacity, what, lower);
     if (shadows) {
-      sh_o.allocate(capacity, what, lower);
-      sh_d.allocate(capacity, what, lower);
-      sh_c.allocate(capacity, what, lower);
-      shadow_q.allocate(capacity, what, lower);
+      sh_o_.allocate(capacity, what, lower);
+      sh_d_.allocate(capacity, what, lower);
+      sh_L_.allocate(capacity, what, lower);
+      sh_target_.allocate(capacity, what, lower);
     }
-    ray_q[0].allocate(capacity, what, lower);
-    ray_q[1].allocate(capacity, what, lower);
-    done_q.allocate(capacity, what, lower);
-    free_q.allocate(capacity, what, lower);
-    ctr.allocate(1, what, lower);
-    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(QueueCounters)));
+    ctr_.allocate(1, what, lower);
+    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(WaveCounters)));
   }
   ~PathPool() { if (host_ctr_) cudaFreeHost(host_ctr_); }
   PathPool(const PathPool&) = delete;
   PathPool& operator=(const PathPool&) = delete;
 
+  // Per path: two state buffers (current and next), the hit, and with light sampling
+  // one shadow ray.
   static uint64_t state_bytes(bool shadows) {
-    return 4 * sizeof(float4) + sizeof(uint32_t) + (shadows ? 2 * sizeof(float4) + sizeof(float) : 0);
-  }
-  static uint64_t queue_bytes(bool shadows) { return sizeof(uint32_t) * (4 + (shadows ? 1 : 0)); }
-  static uint64_t bytes_per_path(bool shadows) { return state_bytes(shadows) + queue_bytes(shadows); }
-
-  Pool view() const {
-    Pool p{};
-    p.o = o.get(); p.d = d.get(); p.beta = beta.get(); p.L = L.get(); p.sample = sample.get();
-    p.sh_o = sh_o.get(); p.sh_d = sh_d.get(); p.sh_c = sh_c.get();
-    p.ray_q[0] = ray_q[0].get(); p.ray_q[1] = ray_q[1].get();
-    p.shadow_q = shadow_q.get(); p.done_q = done_q.get(); p.free_q = free_q.get();
-    p.ctr = ctr.get();
-    p.capacity = uint32_t(capacity_);
-    return p;
+    return 2 * Buffers::bytes_per_path() + sizeof(uint32_t) + (shadows ? 3 * sizeof(float4) + sizeof(uint32_t) : 0);
   }
 
-  // Runs one frame of `total` samples: refills the pool until every sample is done.
-  FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
-                  uint64_t total, uint32_t pixels, FilmDev film, bool variance) {
-    const Pool p = view();
-    launch.launch("pool_init", k_pool_init, capacity_, p);
+  FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+                  uint64_t total, FilmDev film, bool variance) {
+    PB_CUDA_CHECK(cudaMemsetAsync(ctr_.get(), 0, sizeof(WaveCounters), stream));
+    const ShadowSoA sh{sh_o_.get(), sh_d_.get(), sh_L_.get(), sh_target_.get()};
+    WaveCounters* ctr = ctr_.get();
+    const uint32_t cap = uint32_t(capacity_);
     FrameResult r;
     constexpr int kCheckEvery = 4;  // iterations between looks at the counters
     for (uint64_t it = 0;; ++it) {
-      const uint32_t cur = uint32_t(it & 1);
-      launch.launch("schedule", k_schedule, 1, p, cur, static_cast<unsigned long long>(total));
-      launch.launch("generate", k_generate, 0, g.view, c, p, cur, pixels);
-      launch.launch("intersect", k_intersect, 0, g.bvh, p, cur);
-      launch.launch("shade", k_shade, 0, g.view, c, p, cur);
-      if (shadows_) launch.launch("shadow", k_shadow, 0, g.bvh, p);
-      if (variance) launch.launch("accumulate", k_accumulate<true>, 0, p, film);
-      else launch.launch("accumulate", k_accumulate<false>, 0, p, film);
+      const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
+      launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
+      launch.launch("generate", k_wf_generate, 0, g.view, c, cur, ctr, spp);
+      launch.launch("intersect", k_wf_intersect, 0, g.bvh, cur, prim_.get(), ctr);
+      if (variance) launch.launch("shade", k_wf_shade<true>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+      else launch.launch("shade", k_wf_shade<false>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+      if (shadows_) {
+        if (variance) launch.launch("shadow", k_wf_shadow<true>, 0, g.bvh, sh, next, ctr, film);
+        else launch.launch("shadow", k_wf_shadow<false>, 0, g.bvh, sh, next, ctr, film);
+      }
       if (it % kCheckEvery == kCheckEvery - 1) {
-        PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr.get(), sizeof(QueueCounters), cudaMemcpyDeviceToHost, stream));
+        PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
         PB_CUDA_CHECK(cudaStreamSynchronize(stream));
         if (host_ctr_->live == 0 && host_ctr_->next_sample >= total) {
           r.iterations = it + 1;
@@ -614,25 +593,38 @@ class PathPool {
         }
       }
     }
-    // The last schedule booked everything: every path is done.
+    // The last schedule booked every iteration; every generated path has ended.
     r.stats = host_ctr_->stats;
+    r.stats.paths = r.stats.camera;
     r.state_bytes_per_path = state_bytes(shadows_);
-    r.queue_bytes_per_path = queue_bytes(shadows_);
+    r.queue_bytes_per_path = 0;  // the queues are the compacted state buffers themselves
     r.paths_in_flight = capacity_;
-    r.pool_bytes = capacity_ * bytes_per_path(shadows_) + sizeof(QueueCounters);
+    r.pool_bytes = capacity_ * state_bytes(shadows_) + sizeof(WaveCounters);
     return r;
   }
 
  private:
+  struct Buffers {
+    DeviceBuffer<float4> o, d, beta, L;
+    DeviceBuffer<uint32_t> sample;
+    void allocate(uint64_t n, const char* what, const char* lower) {
+      o.allocate(n, what, lower);
+      d.allocate(n, what, lower);
+      beta.allocate(n, what, lower);
+      L.allocate(n, what, lower);
+      sample.allocate(n, what, lower);
+    }
+    PathSoA view() const { return {o.get(), d.get(), beta.get(), L.get(), sample.get()}; }
+    static uint64_t bytes_per_path() { return 4 * sizeof(float4) + sizeof(uint32_t); }
+  };
   uint64_t capacity_;
   bool shadows_;
-  DeviceBuffer<float4> o, d, beta, L;
-  DeviceBuffer<uint32_t> sample;
-  DeviceBuffer<float4> sh_o, sh_d;
-  DeviceBuffer<float> sh_c;
-  DeviceBuffer<uint32_t> ray_q[2], shadow_q, done_q, free_q;
-  DeviceBuffer<QueueCounters> ctr;
-  QueueCounters* host_ctr_ = nullptr;
+  Buffers buf_[2];
+  DeviceBuffer<uint32_t> prim_;
+  DeviceBuffer<float4> sh_o_, sh_d_, sh_L_;
+  DeviceBuffer<uint32_t> sh_target_;
+  DeviceBuffer<WaveCounters> ctr_;
+  WaveCounters* host_ctr_ = nullptr;
 };
 
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
@@ -703,7 +695,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     pool = std::make_unique<PathPool>(pif, shadows, "the wavefront path pool", "--paths-in-flight");
   } else {
     // The paper's global queue: a task for every path of the frame, all at once.
-    const uint64_t per_task = PathPool::bytes_per_path(shadows);
+    const uint64_t per_task = PathPool::state_bytes(shadows);
     const uint64_t need = total * per_task;
     const uint64_t free_b = DeviceMemory::free_bytes();
     if (total > 0xFFFFFFFFull || need + (64ull << 20) > free_b)
@@ -720,7 +712,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   auto run_frame = [&](uint64_t n) {
     if (settings.strategy == Strategy::Pixel)
       return run_pixel(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance(), pixel_stats);
-    return pool->run(launch, stream.s, g, config, n, pixels, fb.view, film.has_variance());
+    return pool->run(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance());
   };
 
   // Warm-up (module load, first-touch of every buffer), then the timed frame.
@@ -785,7 +777,8 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
   x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
   if (settings.strategy != Strategy::Pixel) {
-    x["queue_bytes_per_path"] = r.queue_bytes_per_path;
+    x["state_layout"] = shadows ? "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32 + shadow (3 float4 + u32)"
+                                : "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32";
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
   }
