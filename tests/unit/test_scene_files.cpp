@@ -8,6 +8,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
+#include "test_scene_helpers.h"
 
 namespace pb {
 namespace {
@@ -20,12 +21,8 @@ void expect_same_vec(Vec3f a, Vec3f b, const std::string& what) {
   EXPECT_EQ(a.z, b.z) << what;
 }
 
-uint32_t material_named(const Scene& s, const std::string& name) {
-  for (uint32_t i = 0; i < s.material_names.size(); ++i)
-    if (s.material_names[i] == name) return i;
-  ADD_FAILURE() << "no material " << name;
-  return 0;
-}
+using scene_test::expect_emitters_face_down;
+using scene_test::material_named;
 
 TEST(SceneJson, PaperCornellFileIsTheBuiltin) {
   const Scene a = make_paper_cornell();
@@ -82,12 +79,7 @@ TEST(SceneObj, MaterialsComeFromTheMtl) {
   EXPECT_FLOAT_EQ(red.albedo.y, 0.065f);
   const Material& light = s.materials[material_named(s, "light")];
   EXPECT_FLOAT_EQ(light.emission.x, 12);
-  ASSERT_EQ(s.emitters.size(), 2u);
-  for (uint32_t e : s.emitters) {
-    const Triangle& t = s.triangles[e];
-    const Vec3f n = cross(s.positions[t.v[1]] - s.positions[t.v[0]], s.positions[t.v[2]] - s.positions[t.v[0]]);
-    EXPECT_LT(n.y, 0) << "the light faces down";
-  }
+  expect_emitters_face_down(s, 2);
   // The framing camera looks at the middle of the model from in front (+z).
   EXPECT_GT(s.camera.position.z, s.bounds_max.z);
   EXPECT_LT(s.camera.forward.z, 0);
@@ -117,13 +109,9 @@ TEST_F(SceneObjFile, WithoutAnEmitterGetsADefaultLightAndSaysSo) {
   EXPECT_NE(err.find("cube.obj"), std::string::npos) << err;
   EXPECT_NE(err.find("default area light"), std::string::npos) << err;
   EXPECT_EQ(s.triangles.size(), 12u + 2);
-  ASSERT_EQ(s.emitters.size(), 2u);
-  for (uint32_t e : s.emitters) {
-    const Triangle& t = s.triangles[e];
-    const Vec3f n = cross(s.positions[t.v[1]] - s.positions[t.v[0]], s.positions[t.v[2]] - s.positions[t.v[0]]);
-    EXPECT_LT(n.y, 0) << "the default light faces down";
-    for (uint32_t v : t.v) EXPECT_GT(s.positions[v].y, 0.5f) << "above the cube's top";
-  }
+  expect_emitters_face_down(s, 2);
+  for (uint32_t e : s.emitters)
+    for (uint32_t v : s.triangles[e].v) EXPECT_GT(s.positions[v].y, 0.5f) << "above the cube's top";
   // Faces without usemtl get the grey default.
   EXPECT_FLOAT_EQ(s.materials[s.material_ids[0]].albedo.x, 0.5f);
 }
