@@ -4,6 +4,7 @@
 
 #include <exception>
 
+#include "bench_command.h"
 #include "compare_command.h"
 #include "pathbench/common/errors.h"
 #include "render_command.h"
@@ -18,6 +19,9 @@ int main(int argc, char** argv) {
   pb::app::ReproduceOptions reproduce;
   auto* reproduce_cmd = app.add_subcommand("reproduce", "run the 2015 paper's experiment and print the table");
   pb::app::add_reproduce_options(*reproduce_cmd, reproduce);
+  pb::app::BenchOptions bench;
+  auto* bench_cmd = app.add_subcommand("bench", "run the Google Benchmark harness (pathbench-bench) with a preset");
+  pb::app::add_bench_options(*bench_cmd, bench);
   pb::app::CompareOptions compare;
   auto* compare_cmd = app.add_subcommand("compare", "judge two benchmark JSON files for regressions (Mann-Whitney U)");
   pb::app::add_compare_options(*compare_cmd, compare);
@@ -34,6 +38,7 @@ int main(int argc, char** argv) {
     if (render_cmd->parsed()) return pb::app::run_render(render);
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
     if (compare_cmd->parsed()) return pb::app::run_compare(compare);
+    if (bench_cmd->parsed()) return pb::app::run_bench(bench, bench_cmd->remaining());
   } catch (const pb::InputError& e) {
     fmt::print(stderr, "pathbench: error: {}\n", e.what());
     return pb::kExitBadInput;
