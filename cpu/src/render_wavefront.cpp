@@ -18,7 +18,17 @@ namespace pb::cpu {
 
 namespace {
 
-constexpr int kPacket = 16;
+// Packet width: 8, AVX2's native width. (Measured with callgrind on this AVX2 machine:
+// 16-wide packets ran through the same Embree kernel at the same instruction count.)
+constexpr int kPacket = 8;
+using PacketHit = RTCRayHit8;
+using PacketRay = RTCRay8;
+inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<kPacket>& p) {
+  rtcIntersect8(valid, s, c, reinterpret_cast<PacketHit*>(&p));
+}
+inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<kPacket>& p) {
+  rtcOccluded8(valid, s, c, reinterpret_cast<PacketRay*>(&p));
+}
 
 // Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
 // are neighbours on the image (coherent camera rays).
@@ -86,7 +96,7 @@ void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& 
       if (i < n) set_lane(packet.ray, i, pool.state[pool.live[base + i]].ray, kInfinity);
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect16(valid, job.embree.handle(), &ctx, reinterpret_cast<RTCRayHit16*>(&packet));
+    intersect_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i)
       pool.prim[pool.live[base + i]] =
           packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : packet.hit.primID[i];
@@ -122,7 +132,7 @@ void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx
       valid[i] = i < n ? -1 : 0;
       if (i < n) set_lane(packet, i, pool.shadow[pool.shadowed[base + i]].ray, 1.0f);
     }
-    rtcOccluded16(valid, job.embree.handle(), &ctx, reinterpret_cast<RTCRay16*>(&packet));
+    occluded_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i) {
       const uint32_t slot = pool.shadowed[base + i];
       if (packet.tfar[i] >= 0.0f) shadow_unoccluded(pool.state[slot], pool.shadow[slot]);

@@ -37,7 +37,7 @@ template <class T> PB_HD Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 template <class T> PB_HD T length(Vec3<T> a) { return std::sqrt(dot(a, a)); }
-template <class T> PB_HD Vec3<T> normalize(Vec3<T> a) { return a / length(a); }
+template <class T> PB_HD Vec3<T> normalize(Vec3<T> a) { return a * (T(1) / length(a)); }
 template <class T> PB_HD T pmin(T a, T b) { return a < b ? a : b; }
 template <class T> PB_HD T pmax(T a, T b) { return a > b ? a : b; }
 template <class T> PB_HD T max_component(Vec3<T> a) { return pmax(a.x, pmax(a.y, a.z)); }

@@ -60,13 +60,18 @@ template <class T> PB_HD T emitter_area_pdf(const SceneView& s, Vec3f Le) {
   return T(mean3(Le)) / T(s.emitter_power_total);
 }
 
-// Index of the emitter whose CDF interval holds u (binary search).
-PB_HD uint32_t pick_emitter(const SceneView& s, float u) {
+// Index of the emitter whose CDF interval holds u (binary search). `u` is then
+// rescaled to [0, 1) within that interval, so the same number can place the point on
+// the emitter (sample reuse: one dimension fewer per vertex, stratification kept).
+PB_HD uint32_t pick_emitter(const SceneView& s, float& u) {
   uint32_t lo = 0, hi = s.num_emitters - 1;
   while (lo < hi) {
     uint32_t mid = (lo + hi) / 2;
     if (u < s.emitter_cdf[mid]) hi = mid; else lo = mid + 1;
   }
+  const float below = lo > 0 ? s.emitter_cdf[lo - 1] : 0.0f;
+  const float width = s.emitter_cdf[lo] - below;
+  u = width > 0.0f ? pmin((u - below) / width, 0x1.fffffep-1f) : 0.0f;
   return lo;
 }
 
@@ -96,18 +101,18 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
   const Vec3<T> f = Vec3<T>(m.albedo) * kInvPi<T>;
   const uint32_t vertex = st.depth + 1;
   const RngStream rng{st.pixel, c.seed};
-  const Uniform4 ub = rng.draw(st.sample, vertex, kRngBsdf);
+  const Uniform4 ub = rng.draw(st.sample, vertex, kRngVertex);
   const Vec3<T> origin = offset_ray_origin(h.p, n, s.offset);
 
   // 3. Light sampling.
   if (c.sampling == Sampling::Nee && s.num_emitters > 0) {
-    const uint32_t tri_id = s.emitters[pick_emitter(s, ub.v[3])];
+    float u_pick = ub.v[2];
+    const uint32_t tri_id = s.emitters[pick_emitter(s, u_pick)];
     const Triangle tri = s.triangles[tri_id];
     const Vec3<T> v0 = Vec3<T>(s.positions[tri.v[0]]);
     const Vec3<T> e1 = Vec3<T>(s.positions[tri.v[1]]) - v0;
     const Vec3<T> e2 = Vec3<T>(s.positions[tri.v[2]]) - v0;
-    const Uniform4 ul = rng.draw(st.sample, vertex, kRngLight);
-    const Barycentrics<T> b = sample_uniform_triangle(T(ul.v[0]), T(ul.v[1]));
+    const Barycentrics<T> b = sample_uniform_triangle(T(u_pick), T(ub.v[3]));
     const Vec3<T> y = v0 + e1 * b.b1 + e2 * b.b2;
     const Vec3<T> nl = normalize(cross(e1, e2));
     Vec3<T> wi = y - h.p;
@@ -142,7 +147,7 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
   // 5. Russian roulette.
   if (c.russian_roulette && vertex >= c.rr_start_depth) {
     const T q = pmin(max_component(st.beta), T(0.95));
-    if (!(T(ub.v[2]) < q)) return PathEvent::Done;
+    if (!(T(rng.draw(st.sample, vertex, kRngRoulette).v[0]) < q)) return PathEvent::Done;
     st.beta = st.beta / q;
   }
 

@@ -11,11 +11,12 @@
 
 namespace pb {
 
-// Dimension groups drawn at one path vertex; each call yields four uniforms.
+// Dimension groups; each draw yields four uniforms. One draw per path vertex covers
+// the common case (a Philox call is the largest single cost of a vertex).
 enum RngGroup : uint32_t {
-  kRngCamera = 0,   // u0,u1: pixel jitter
-  kRngBsdf = 1,     // u0,u1: direction; u2: Russian roulette; u3: emitter choice
-  kRngLight = 2,    // u0,u1: point on the emitter triangle
+  kRngCamera = 0,     // u0,u1: pixel jitter
+  kRngVertex = 1,     // u0,u1: BSDF direction; u2: emitter choice, reused for the point; u3: point
+  kRngRoulette = 2,   // u0: Russian roulette (drawn only when roulette applies)
 };
 
 struct Uniform4 {
