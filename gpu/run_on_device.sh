@@ -18,6 +18,9 @@ log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
 B=build-gpu
 PB=$B/bin/pathbench
 
+# The commit this tree was (a copy of), for the reports: the device has no .git.
+if [ -f .gpu-deps/source-commit ]; then export PATHBENCH_SOURCE_COMMIT=$(cat .gpu-deps/source-commit); fi
+log "source commit: ${PATHBENCH_SOURCE_COMMIT:-unknown}"
 if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi
 nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.sm,clocks.max.sm --format=csv | tee "$OUT/logs/nvidia-smi.txt"
 
@@ -78,6 +81,7 @@ if has bench; then
   log "paper-cornell 256x256x800, 2 bounces, nee"
   for i in 1 2 3 4 5; do render paper-pixel-$i $paper --strategy pixel; done
   for i in 1 2 3; do render paper-wavefront-$i $paper --strategy wavefront; done
+  for pif in 337920 675840 2703360; do render paper-wavefront-pif$pif $paper --strategy wavefront --paths-in-flight $pif; done
   render paper-paperqueue $paper --strategy paper-queue
   log "profiles"
   timeout 60 $PB render --device gpu --quiet $paper --strategy pixel --profile | tee -a "$OUT/summary.txt"

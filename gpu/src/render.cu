@@ -8,6 +8,7 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -281,7 +282,7 @@ __global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint3
 
 // New samples after the continuing paths; a warp takes consecutive samples of a pixel,
 // as the pixel strategy does (coherent camera rays).
-__global__ void k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const WaveCounters* ctr, uint32_t spp) {
+__global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const WaveCounters* ctr, uint32_t spp) {
   const uint32_t n = ctr->gen_count, dst = ctr->gen_dst;
   const unsigned long long base = ctr->gen_base;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
@@ -292,7 +293,7 @@ __global__ void k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const Wave
   }
 }
 
-__global__ void k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+__global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
   const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const float4 o = cur.o[i], d = cur.d[i];
@@ -302,7 +303,7 @@ __global__ void k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const W
 }
 
 template <bool kVariance>
-__global__ void k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next, const uint32_t* prim, ShadowSoA sh,
+__global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next, const uint32_t* prim, ShadowSoA sh,
                            WaveCounters* ctr, FilmDev film) {
   const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
@@ -334,7 +335,7 @@ __global__ void k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
 }
 
 template <bool kVariance>
-__global__ void k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr, FilmDev film) {
+__global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr, FilmDev film) {
   const uint32_t n = ctr->n_shadow;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const float4 o = sh.o[i], d = sh.d[i], l = sh.L[i];
@@ -363,6 +364,25 @@ __global__ void k_trace(BvhView bvh, const TraceQuery* rays, TraceResult* out, u
     uint32_t prim = any_hit ? traverse<true>(bvh, r.o, r.d, r.t_max, t) : traverse<false>(bvh, r.o, r.d, r.t_max, t);
     out[i] = {prim, t};
   }
+}
+
+// The kernel driver's version ("580.159.04"), from /proc on Linux; empty elsewhere.
+std::string kernel_driver_version() {
+  std::FILE* f = std::fopen("/proc/driver/nvidia/version", "r");
+  if (!f) return {};
+  char line[512] = {0};
+  std::string v;
+  if (std::fgets(line, sizeof line, f)) {
+    const std::string l = line;
+    const size_t k = l.find("Kernel Module");
+    if (k != std::string::npos) {
+      size_t a = l.find_first_of("0123456789", k);
+      size_t b = a == std::string::npos ? a : l.find_first_of(" \t\n", a);
+      if (a != std::string::npos) v = l.substr(a, b == std::string::npos ? std::string::npos : b - a);
+    }
+  }
+  std::fclose(f);
+  return v;
 }
 
 std::string slugify(const std::string& name) {
@@ -763,7 +783,8 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
               {"compute_capability", fmt::format("{}.{}", info.compute_major, info.compute_minor)},
               {"multiprocessors", info.multiprocessors},
               {"memory_bytes", info.total_memory},
-              {"driver_version", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10)},
+              {"driver_version", kernel_driver_version()},
+              {"driver_cuda_version", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10)},
               {"cuda_runtime_version", fmt::format("{}.{}", info.runtime_version / 1000, (info.runtime_version % 1000) / 10)},
               {"cuda_architectures_built", PATHBENCH_CUDA_ARCHS}};
   x["device_bytes_allocated_peak"] = mem.peak_allocated();
@@ -775,6 +796,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
               {"builder", "embree rtcBuildBVH, binned SAH, binary"}};
   x["device_samples_per_second"] = device_ms > 0 ? double(r.stats.paths) / (device_ms / 1e3) : 0.0;
   x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
+  if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;
   x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
   if (settings.strategy != Strategy::Pixel) {
     x["state_layout"] = shadows ? "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32 + shadow (3 float4 + u32)"
