@@ -109,6 +109,65 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
   }
 }
 
+// Film add for a whole warp (all 32 lanes call it, convergent): samples of the same
+// pixel in consecutive lanes are summed first (exact integer sums), then one atomic per
+// pixel and channel. Strategies that hand out consecutive samples of a pixel to
+// neighbouring lanes thus need ~1/32 of the atomics, and no lane of a warp waits on
+// 32 same-address atomics.
+template <bool kVariance>
+__device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uint32_t pixel, const Vec3f& L,
+                                              unsigned long long* discarded) {
+  const uint32_t lane = threadIdx.x & 31;
+  const bool ok = add && sample_acceptable(L, film.limit);
+  if (add && !ok) atomicAdd(discarded, 1ull);
+  const uint32_t key = ok ? pixel : 0xFFFFFFFFu;
+  long long q0 = ok ? quantize_radiance(L.x, film.scale) : 0;
+  long long q1 = ok ? quantize_radiance(L.y, film.scale) : 0;
+  long long q2 = ok ? quantize_radiance(L.z, film.scale) : 0;
+  uint32_t cnt = ok ? 1u : 0u;
+  double s0 = 0, s1 = 0, s2 = 0;
+  if (kVariance && ok) {
+    s0 = double(L.x) * double(L.x);
+    s1 = double(L.y) * double(L.y);
+    s2 = double(L.z) * double(L.z);
+  }
+  // Segmented sum over runs of equal keys in consecutive lanes (Hillis-Steele: after
+  // the step with offset `off`, a lane holds the sum of [lane, lane + 2 off) within
+  // its run).
+#pragma unroll
+  for (int off = 1; off < 32; off <<= 1) {
+    const uint32_t k2 = __shfl_down_sync(kFullMask, key, off);
+    const long long a0 = __shfl_down_sync(kFullMask, q0, off), a1 = __shfl_down_sync(kFullMask, q1, off),
+                    a2 = __shfl_down_sync(kFullMask, q2, off);
+    const uint32_t c2 = __shfl_down_sync(kFullMask, cnt, off);
+    double b0 = 0, b1 = 0, b2 = 0;
+    if (kVariance) {
+      b0 = __shfl_down_sync(kFullMask, s0, off);
+      b1 = __shfl_down_sync(kFullMask, s1, off);
+      b2 = __shfl_down_sync(kFullMask, s2, off);
+    }
+    if (lane + off < 32 && k2 == key) {
+      q0 += a0; q1 += a1; q2 += a2;
+      cnt += c2;
+      if (kVariance) { s0 += b0; s1 += b1; s2 += b2; }
+    }
+  }
+  const uint32_t prev = __shfl_up_sync(kFullMask, key, 1);
+  if (key != 0xFFFFFFFFu && (lane == 0 || prev != key)) {
+    unsigned long long* sum = film.sum + size_t(key) * 3;
+    atomicAdd(sum + 0, static_cast<unsigned long long>(q0));
+    atomicAdd(sum + 1, static_cast<unsigned long long>(q1));
+    atomicAdd(sum + 2, static_cast<unsigned long long>(q2));
+    atomicAdd(film.count + key, cnt);
+    if (kVariance) {
+      double* sq = film.sum_sq + size_t(key) * 3;
+      atomicAdd(sq + 0, s0);
+      atomicAdd(sq + 1, s1);
+      atomicAdd(sq + 2, s2);
+    }
+  }
+}
+
 template <bool kVariance>
 __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
@@ -125,46 +184,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
       L = trace_path(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
-    const bool ok = valid && sample_acceptable(L, film.limit);
-    if (valid && !ok) ++n_discarded;
-    long long q0 = ok ? quantize_radiance(L.x, film.scale) : 0;
-    long long q1 = ok ? quantize_radiance(L.y, film.scale) : 0;
-    long long q2 = ok ? quantize_radiance(L.z, film.scale) : 0;
-    uint32_t cnt = ok ? 1u : 0u;
-    double s0 = 0, s1 = 0, s2 = 0;
-    if (kVariance && ok) {
-      s0 = double(L.x) * double(L.x);
-      s1 = double(L.y) * double(L.y);
-      s2 = double(L.z) * double(L.z);
-    }
-    // Segmented sum over lanes of the same pixel (consecutive lanes).
-#pragma unroll
-    for (int off = 1; off < 32; off <<= 1) {
-      const uint32_t p2 = shfl_down(pixel, off);
-      const long long a0 = shfl_down(q0, off), a1 = shfl_down(q1, off), a2 = shfl_down(q2, off);
-      const uint32_t c2 = shfl_down(cnt, off);
-      double b0 = 0, b1 = 0, b2 = 0;
-      if (kVariance) { b0 = shfl_down(s0, off); b1 = shfl_down(s1, off); b2 = shfl_down(s2, off); }
-      if (lane + off < 32 && p2 == pixel) {
-        q0 += a0; q1 += a1; q2 += a2;
-        cnt += c2;
-        if (kVariance) { s0 += b0; s1 += b1; s2 += b2; }
-      }
-    }
-    const uint32_t prev = __shfl_up_sync(kFullMask, pixel, 1);
-    if (valid && cnt && (lane == 0 || prev != pixel)) {
-      unsigned long long* sum = film.sum + size_t(pixel) * 3;
-      atomicAdd(sum + 0, static_cast<unsigned long long>(q0));
-      atomicAdd(sum + 1, static_cast<unsigned long long>(q1));
-      atomicAdd(sum + 2, static_cast<unsigned long long>(q2));
-      atomicAdd(film.count + pixel, cnt);
-      if (kVariance) {
-        double* sq = film.sum_sq + size_t(pixel) * 3;
-        atomicAdd(sq + 0, s0);
-        atomicAdd(sq + 1, s1);
-        atomicAdd(sq + 2, s2);
-      }
-    }
+    film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
   }
   block_stats_add(stats, n_bounce, n_shadow, n_paths, n_discarded);
 }
@@ -216,25 +236,6 @@ __device__ __forceinline__ uint32_t queue_push(uint32_t* counter) {
   if (int(lane) == leader) base = atomicAdd(counter, uint32_t(__popc(mask)));
   base = __shfl_sync(mask, base, leader);
   return base + uint32_t(__popc(mask & ((1u << lane) - 1u)));
-}
-
-template <bool kVariance>
-__device__ __forceinline__ void film_add(const FilmDev& film, uint32_t pixel, const Vec3f& L, Stats* stats) {
-  if (!sample_acceptable(L, film.limit)) {
-    atomicAdd(&stats->discarded, 1ull);
-    return;
-  }
-  unsigned long long* sum = film.sum + size_t(pixel) * 3;
-  atomicAdd(sum + 0, static_cast<unsigned long long>(quantize_radiance(L.x, film.scale)));
-  atomicAdd(sum + 1, static_cast<unsigned long long>(quantize_radiance(L.y, film.scale)));
-  atomicAdd(sum + 2, static_cast<unsigned long long>(quantize_radiance(L.z, film.scale)));
-  atomicAdd(film.count + pixel, 1u);
-  if (kVariance) {
-    double* sq = film.sum_sq + size_t(pixel) * 3;
-    atomicAdd(sq + 0, double(L.x) * double(L.x));
-    atomicAdd(sq + 1, double(L.y) * double(L.y));
-    atomicAdd(sq + 2, double(L.z) * double(L.z));
-  }
 }
 
 __device__ __forceinline__ PathState<float> load_path(const PathSoA& p, uint32_t i) {
@@ -303,55 +304,76 @@ __global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cu
 }
 
 template <bool kVariance>
-__global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next, const uint32_t* prim, ShadowSoA sh,
-                           WaveCounters* ctr, FilmDev film) {
+__global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
+                                                     const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film) {
   const uint32_t n = ctr->n_cur;
-  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    PathState<float> st = load_path(cur, i);
-    const uint32_t h = prim[i];
-    if (h == kNoHit) {
-      film_add<kVariance>(film, st.pixel, st.L, &ctr->stats);
-      continue;
+  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
+  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
+    const uint32_t i = base + lane;
+    bool add = false;
+    uint32_t pixel = 0;
+    Vec3f L_add{0.0f, 0.0f, 0.0f};
+    if (i < n) {
+      PathState<float> st = load_path(cur, i);
+      const uint32_t h = prim[i];
+      pixel = st.pixel;
+      if (h == kNoHit) {
+        add = true;
+        L_add = st.L;
+      } else {
+        ShadowQuery<float> q;
+        bool wants_shadow;
+        const PathEvent ev = path_hit(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+        uint32_t target = kShadowDone | st.pixel;
+        if (ev == PathEvent::Continue) {
+          const uint32_t j = queue_push(&ctr->n_next);
+          store_path(next, j, st);
+          target = j;
+        }
+        if (wants_shadow) {
+          const uint32_t k = queue_push(&ctr->n_shadow);
+          sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
+          sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
+          sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, q.contribution.z);
+          sh.target[k] = target;
+        } else if (ev == PathEvent::Done) {
+          add = true;
+          L_add = st.L;
+        }
+      }
     }
-    ShadowQuery<float> q;
-    bool wants_shadow;
-    const PathEvent ev = path_hit(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
-    uint32_t target = kShadowDone | st.pixel;
-    if (ev == PathEvent::Continue) {
-      const uint32_t j = queue_push(&ctr->n_next);
-      store_path(next, j, st);
-      target = j;
-    }
-    if (wants_shadow) {
-      const uint32_t k = queue_push(&ctr->n_shadow);
-      sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
-      sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
-      sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, q.contribution.z);
-      sh.target[k] = target;
-    } else if (ev == PathEvent::Done) {
-      film_add<kVariance>(film, st.pixel, st.L, &ctr->stats);
-    }
+    film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
   }
 }
 
 template <bool kVariance>
-__global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr, FilmDev film) {
+__global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
+                                                      FilmDev film) {
   const uint32_t n = ctr->n_shadow;
-  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const float4 o = sh.o[i], d = sh.d[i], l = sh.L[i];
-    const uint32_t target = sh.target[i];
-    const bool visible = !occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f);
-    if (target & kShadowDone) {
-      Vec3f L{l.x, l.y, l.z};
-      if (visible) L = L + Vec3f{o.w, d.w, l.w};  // shadow_unoccluded: L += contribution
-      film_add<kVariance>(film, target & ~kShadowDone, L, &ctr->stats);
-    } else if (visible) {
-      float4 L = next.L[target];
-      L.x = L.x + o.w;
-      L.y = L.y + d.w;
-      L.z = L.z + l.w;
-      next.L[target] = L;
+  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
+  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
+    const uint32_t i = base + lane;
+    bool add = false;
+    uint32_t pixel = 0;
+    Vec3f L{0.0f, 0.0f, 0.0f};
+    if (i < n) {
+      const float4 o = sh.o[i], d = sh.d[i], l = sh.L[i];
+      const uint32_t target = sh.target[i];
+      const bool visible = !occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f);
+      if (target & kShadowDone) {
+        L = {l.x, l.y, l.z};
+        if (visible) L = L + Vec3f{o.w, d.w, l.w};  // shadow_unoccluded: L += contribution
+        add = true;
+        pixel = target & ~kShadowDone;
+      } else if (visible) {
+        float4 Lt = next.L[target];
+        Lt.x = Lt.x + o.w;
+        Lt.y = Lt.y + d.w;
+        Lt.z = Lt.z + l.w;
+        next.L[target] = Lt;
+      }
     }
+    film_add_warp<kVariance>(film, add, pixel, L, &ctr->stats.discarded);
   }
 }
 
