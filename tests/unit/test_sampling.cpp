@@ -53,13 +53,13 @@ struct SphereHistogram {
   // Expected counts for `n` samples of a density pdf(cos theta, phi) (per steradian;
   // d omega = d cos d phi). Bins where `support(c0, c1)` is false get zero.
   template <class Pdf, class Support>
-  std::vector<double> expected(Pdf&& pdf, Support&& support, double n) const {
+  std::vector<double> expected(Pdf&& pdf, Support&& support, double n, int simpson_n = 16) const {
     std::vector<double> e(counts.size());
     for (int i = 0; i < n_cos; ++i) {
       const double c0 = -1 + 2.0 * i / n_cos, c1 = -1 + 2.0 * (i + 1) / n_cos;
       for (int j = 0; j < n_phi; ++j) {
         const double p0 = 2 * kPi<double> * j / n_phi, p1 = 2 * kPi<double> * (j + 1) / n_phi;
-        e[size_t(i) * n_phi + j] = support(c0, c1) ? n * stat::simpson_2d(pdf, c0, c1, p0, p1) : 0.0;
+        e[size_t(i) * n_phi + j] = support(c0, c1) ? n * stat::simpson_2d(pdf, c0, c1, p0, p1, simpson_n) : 0.0;
       }
     }
     return e;
@@ -96,6 +96,36 @@ void expect_chi_square_passes(const std::vector<double>& observed, const std::ve
   const stat::ChiSquare r = stat::chi_square(observed, expected);
   std::printf("[ chi2     ] %s: %s (reject below %.3g)\n", what, r.message.c_str(), kAlpha);
   EXPECT_TRUE(r.passes(kAlpha)) << what << ": " << r.message << ", alpha " << kAlpha;
+}
+
+// ---- The statistics themselves ----------------------------------------------------
+
+TEST(ChiSquare, PValuesMatchTables) {
+  EXPECT_NEAR(stat::chi2_pvalue(3.841459, 1), 0.05, 1e-6);
+  EXPECT_NEAR(stat::chi2_pvalue(18.307038, 10), 0.05, 1e-6);
+  EXPECT_NEAR(stat::chi2_pvalue(6.634897, 1), 0.01, 1e-6);
+  EXPECT_NEAR(stat::chi2_pvalue(1000, 1000), 0.4940528, 1e-5);
+  EXPECT_NEAR(stat::chi2_pvalue(2, 2), std::exp(-1.0), 1e-12);  // 2 dof: exp(-x/2)
+  EXPECT_NEAR(stat::regularized_gamma_p(3, 2.5) + stat::regularized_gamma_q(3, 2.5), 1.0, 1e-14);
+  EXPECT_NEAR(stat::sidak_alpha(0.01, 1), 0.01, 1e-15);
+  EXPECT_NEAR(stat::normal_two_sided_p(1.959964), 0.05, 1e-6);
+}
+
+TEST(ChiSquare, RejectsAWrongPdf) {
+  // The test has power: cosine-weighted samples against the uniform density fail.
+  SphereHistogram h(32, 64);
+  for (uint32_t i = 0; i < kSamples / 10; ++i) {
+    const auto u = draw(i);
+    h.add(to_d(sample_cosine_hemisphere(u[0], u[1])));
+  }
+  const auto e = h.expected([](double, double) { return double(uniform_hemisphere_pdf<float>()); },
+                            [](double, double c1) { return c1 > 0; }, kSamples / 10);
+  const stat::ChiSquare r = stat::chi_square(h.counts, e);
+  EXPECT_FALSE(r.passes(kAlpha)) << r.message;
+  EXPECT_LT(r.p, 1e-100) << r.message;
+  // ... and samples where the density is zero fail outright.
+  std::vector<double> obs = {5, 10, 1}, exp = {8, 8, 0};
+  EXPECT_TRUE(stat::chi_square(obs, exp).impossible);
 }
 
 // ---- The random stream ---------------------------------------------------------
@@ -167,38 +197,40 @@ TEST(RngStream, UniformChiSquare2DAcrossPixels) {
 
 // ---- Hemisphere samplers -------------------------------------------------------
 
-TEST(Sampling, UniformHemisphereMatchesPdf) {
+// Draws kSamples directions with sample(u0, u1) from the project's random stream,
+// checks each is a unit vector, and tests their histogram against pdf(cos theta, phi)
+// (zero in bins where support(c0, c1) is false). `simpson_n` intervals per bin axis.
+template <class Sample, class Pdf, class Support>
+void check_direction_sampler(const char* what, Sample&& sample, Pdf&& pdf, Support&& support, int simpson_n = 16,
+                             uint32_t pixel = 12345) {
   SphereHistogram h(32, 64);
   for (uint32_t i = 0; i < kSamples; ++i) {
-    const auto u = draw(i);
-    const Vec3d w = to_d(sample_uniform_hemisphere(u[0], u[1]));
-    ASSERT_NEAR(length(w), 1.0, 1e-5);
+    const auto u = draw(i, pixel);
+    const Vec3d w = to_d(sample(u[0], u[1]));
+    ASSERT_NEAR(length(w), 1.0, 1e-5) << what;
     h.add(w);
   }
-  // The density is uniform_hemisphere_pdf() on the upper hemisphere, zero below.
-  const auto e = h.expected([](double, double) { return double(uniform_hemisphere_pdf<float>()); },
-                            [](double, double c1) { return c1 > 0; }, kSamples);
+  const auto e = h.expected(pdf, support, kSamples, simpson_n);
   double total = 0;
   for (double x : e) total += x;
-  EXPECT_NEAR(total, kSamples, 1e-3 * kSamples) << "the pdf does not integrate to 1";
-  expect_chi_square_passes(h.counts, e, "sample_uniform_hemisphere");
+  EXPECT_NEAR(total, kSamples, 1e-3 * kSamples) << what << ": the pdf does not integrate to 1";
+  expect_chi_square_passes(h.counts, e, what);
+}
+
+const auto kWholeSphere = [](double, double) { return true; };
+
+TEST(Sampling, UniformHemisphereMatchesPdf) {
+  // The density is uniform_hemisphere_pdf() on the upper hemisphere, zero below.
+  check_direction_sampler(
+      "sample_uniform_hemisphere", [](float u0, float u1) { return sample_uniform_hemisphere(u0, u1); },
+      [](double, double) { return double(uniform_hemisphere_pdf<float>()); },
+      [](double, double c1) { return c1 > 0; });
 }
 
 TEST(Sampling, CosineHemisphereMatchesPdf) {
-  SphereHistogram h(32, 64);
-  for (uint32_t i = 0; i < kSamples; ++i) {
-    const auto u = draw(i);
-    const Vec3d w = to_d(sample_cosine_hemisphere(u[0], u[1]));
-    ASSERT_NEAR(length(w), 1.0, 1e-5);
-    ASSERT_GE(w.z, 0.0);
-    h.add(w);
-  }
-  const auto e = h.expected([](double c, double) { return double(cosine_hemisphere_pdf(float(c))); },
-                            [](double, double) { return true; }, kSamples);
-  double total = 0;
-  for (double x : e) total += x;
-  EXPECT_NEAR(total, kSamples, 1e-3 * kSamples) << "the pdf does not integrate to 1";
-  expect_chi_square_passes(h.counts, e, "sample_cosine_hemisphere");
+  check_direction_sampler(
+      "sample_cosine_hemisphere", [](float u0, float u1) { return sample_cosine_hemisphere(u0, u1); },
+      [](double c, double) { return double(cosine_hemisphere_pdf(float(c))); }, kWholeSphere);
 }
 
 TEST(Sampling, CosineHemisphereThroughFrameMatchesPdf) {
@@ -206,25 +238,15 @@ TEST(Sampling, CosineHemisphereThroughFrameMatchesPdf) {
   // direction must have density cos(n, w) / pi about the shading normal n.
   const Vec3f n = normalize(Vec3f{1, 2, -3});
   const Frame<float> f = Frame<float>::from_normal(n);
-  SphereHistogram h(32, 64);
-  for (uint32_t i = 0; i < kSamples; ++i) {
-    const auto u = draw(i, 777);
-    h.add(to_d(f.to_world(sample_cosine_hemisphere(u[0], u[1]))));
-  }
   const Vec3d nd = Vec3d(n);
   const auto pdf = [&](double c, double phi) {
     const double s = std::sqrt(std::max(0.0, 1 - c * c));
     return std::max(0.0, dot(nd, Vec3d{s * std::cos(phi), s * std::sin(phi), c})) / kPi<double>;
   };
   // The density has a kink along the great circle dot(n, w) = 0: finer Simpson there.
-  std::vector<double> e(h.counts.size());
-  for (int i = 0; i < h.n_cos; ++i)
-    for (int j = 0; j < h.n_phi; ++j) {
-      const double c0 = -1 + 2.0 * i / h.n_cos, c1 = -1 + 2.0 * (i + 1) / h.n_cos;
-      const double p0 = 2 * kPi<double> * j / h.n_phi, p1 = 2 * kPi<double> * (j + 1) / h.n_phi;
-      e[size_t(i) * h.n_phi + j] = kSamples * stat::simpson_2d(pdf, c0, c1, p0, p1, 64);
-    }
-  expect_chi_square_passes(h.counts, e, "cosine hemisphere through Frame");
+  check_direction_sampler(
+      "cosine hemisphere through Frame",
+      [&](float u0, float u1) { return f.to_world(sample_cosine_hemisphere(u0, u1)); }, pdf, kWholeSphere, 64, 777);
 }
 
 // ---- Triangle ------------------------------------------------------------------
