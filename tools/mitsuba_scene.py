@@ -222,7 +222,7 @@ def write_xml(outdir, spp=64, width=WIDTH, height=HEIGHT):
                       f'<boolean name="face_normals" value="true"/>{inner}</shape>')
     o, t, u = (", ".join(f"{x:g}" for x in v) for v in (CAMERA_ORIGIN, CAMERA_TARGET, CAMERA_UP))
     xml = f"""<?xml version="1.0"?>
-<!-- pathbench paper-cornell (tools/mitsuba_scene.py --xml) -->
+<!-- pathbench paper-cornell, written by tools/mitsuba_scene.py (option xml) -->
 <scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="{MAX_DEPTH}"/><integer name="rr_depth" value="{MAX_DEPTH + 100}"/></integrator>
   <sensor type="perspective">

@@ -1,0 +1,57 @@
+"""Helpers of the Python tools that need no renderer: the machine slug (same rule as
+pb::machine_slug), the reference statistics and the speed report's Markdown."""
+import numpy as np
+import pytest
+
+import machine
+import make_reference
+import mitsuba_speed
+
+
+@pytest.mark.parametrize("model, slug", [
+    ("AMD EPYC 7B13 64-Core Processor", "amd-epyc-7b13-64-core"),
+    ("Intel(R) Xeon(R) CPU @ 2.20GHz", "intel-r-xeon-r-cpu-2-20ghz"),
+    ("AMD EPYC", "amd-epyc"),
+    ("  Some  CPU  ", "some"),
+    ("Neoverse-N1 CPU processor", "neoverse-n1"),
+    ("", "unknown-machine"),
+])
+def test_machine_slug(model, slug):
+    assert machine.machine_slug(model) == slug
+
+
+def test_machine_slug_of_this_machine_is_a_folder_name():
+    s = machine.machine_slug()
+    assert s and all(c.isalnum() or c == "-" for c in s) and s == s.lower()
+
+
+def test_reference_from_passes():
+    rng = np.random.default_rng(1)
+    passes = rng.normal(2.0, 0.5, size=(64, 4, 5, 3))
+    passes[:, 0, 0, :] = 10.0  # a constant pixel: variance exactly 0
+    mean, var = make_reference.reference_from_passes(passes)
+    assert mean.shape == var.shape == (4, 5, 3)
+    assert np.allclose(mean, passes.mean(axis=0))
+    assert np.allclose(var, passes.var(axis=0, ddof=1) / 64)
+    assert (var[0, 0] == 0).all() and (mean[0, 0] == 10).all()
+    with pytest.raises(ValueError):
+        make_reference.reference_from_passes(passes[:1])
+
+
+def test_speed_markdown():
+    res = {
+        "date": "2026-01-01 00:00 UTC",
+        "machine": {"slug": "x", "cpu": "Test CPU", "hardware_threads": 2},
+        "settings": {"width": 256, "height": 256, "spp": 800},
+        "load_average_before": [0.1, 0.1, 0.1], "load_average_after": [1.0, 1.0, 1.0],
+        "mitsuba": {"renderer": "Mitsuba 3.9.1", "variant": "llvm_ad_rgb", "median_seconds": 40.0,
+                    "seconds": [40.0, 41.0, 39.0], "warmup_seconds": 50.0, "estimated_rays_per_second": 5.8e6,
+                    "rays_per_sample_assumed": 4.4, "image_mean_rgb": [0.5, 0.5, 0.45]},
+        "pathbench": {"pixel": {"median_seconds": 20.0, "seconds": [20.0, 21.0, 19.0],
+                                "median_rays_per_second": 11.5e6, "image_mean_rgb": [0.5, 0.5, 0.45],
+                                "git_revision": "abc", "compiler": "gcc"}},
+    }
+    md = mitsuba_speed.markdown(res)
+    assert "| pathbench cpu/pixel | 20.00" in md
+    assert "2.00x" in md
+    assert "estimate" in md

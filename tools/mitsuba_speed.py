@@ -1,0 +1,229 @@
+#!/usr/bin/env python3
+"""Speed of pathbench's CPU tracer against Mitsuba 3 on the paper's scene, on this
+machine, back to back in one run (interleaved rounds). Re-run after any change to the CPU tracer:
+
+    .venv/bin/python tools/mitsuba_speed.py          # needs build/bin/pathbench (scripts/build.sh)
+
+Both render paper-cornell at 256 x 256, 800 spp, two bounces (Mitsuba: `path`,
+max_depth = 3; pathbench: --bounces 2 --sampling nee), box filter, all hardware
+threads. Mitsuba 3 runs its llvm_ad_rgb variant (needs libLLVM: apt-get install
+libllvm19); one warm-up render (JIT compilation) is excluded, then --repeats renders
+are timed and the median is reported. pathbench runs `pathbench render ... --strategy
+pixel|wavefront --report` --repeats times each, median of its own reported seconds.
+The runs go in rounds (Mitsuba, pixel, wavefront; again), so load that comes and goes
+during the run is shared out evenly.
+
+Mitsuba does not count rays. Its rays per second are an ESTIMATE: its samples per
+second times pathbench's measured rays per sample for the same estimator (camera ray,
+then at each of the first two hits one shadow ray and one continuation ray).
+
+Writes results/<machine>/mitsuba-vs-pathbench.json and .md, <machine> being the slug
+pb::machine_slug gives (tools/machine.py).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import mitsuba_scene as ms  # noqa: E402
+from machine import cpu_model, machine_slug  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def loadavg():
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return None
+
+
+class MitsubaRunner:
+    """Mitsuba 3 on paper-cornell; the constructor loads the scene and does the
+    warm-up render (JIT compilation), excluded from the timings."""
+
+    def __init__(self, spp, variant, size):
+        self.mi = ms.import_mitsuba(variant)
+        import drjit as dr  # noqa: PLC0415
+
+        self.dr, self.spp, self.variant = dr, spp, variant
+        self.scene = ms.load_scene(self.mi, width=size, height=size, spp=spp)
+        t0 = time.perf_counter()
+        self.img = ms.render(self.mi, self.scene, spp, seed=0)
+        self.warmup = time.perf_counter() - t0
+        self.times = []
+        print(f"mitsuba {variant}: warm-up {self.warmup:.2f} s (excluded)", flush=True)
+
+    def run(self):
+        self.dr.sync_thread()
+        t0 = time.perf_counter()
+        # ms.render copies the image to numpy, so the render is complete when it returns.
+        self.img = ms.render(self.mi, self.scene, self.spp, seed=len(self.times) + 1)
+        self.dr.sync_thread()
+        self.times.append(time.perf_counter() - t0)
+        print(f"mitsuba {self.variant}: render {len(self.times)}: {self.times[-1]:.2f} s", flush=True)
+
+    def result(self):
+        return {
+            "renderer": f"Mitsuba {self.mi.__version__}",
+            "variant": self.variant,
+            "integrator": f"path, max_depth {ms.MAX_DEPTH}, rr_depth beyond max_depth (no Russian roulette)",
+            "threads": "all (Dr.Jit's thread pool)",
+            "warmup_seconds": round(self.warmup, 3),
+            "seconds": [round(t, 3) for t in self.times],
+            "median_seconds": round(statistics.median(self.times), 3),
+            "image_mean_rgb": [round(float(x), 5) for x in self.img.reshape(-1, 3).mean(axis=0)],
+            "peak_rss_bytes_this_process": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+        }
+
+
+class PathbenchRunner:
+    """`pathbench render` on paper-cornell with one strategy; its own report's seconds."""
+
+    def __init__(self, binary, strategy, spp, size, tmp):
+        self.binary, self.strategy, self.spp, self.size, self.tmp = binary, strategy, spp, size, Path(tmp)
+        self.runs = []
+
+    def run(self):
+        k = len(self.runs)
+        report = self.tmp / f"{self.strategy}-{k}.json"
+        image = self.tmp / f"{self.strategy}-{k}.pfm"
+        cmd = [str(self.binary), "render", "--scene", "paper-cornell", "--width", str(self.size), "--height",
+               str(self.size), "--spp", str(self.spp), "--bounces", "2", "--sampling", "nee", "--strategy",
+               self.strategy, "--seed", str(k + 1), "--out", str(image), "--report", str(report), "--quiet"]
+        subprocess.run(cmd, check=True)
+        r = json.loads(report.read_text())
+        r["image_mean_rgb"] = [round(float(x), 5) for x in ms.read_pfm(image).reshape(-1, 3).mean(axis=0)]
+        self.runs.append(r)
+        print(f"pathbench {self.strategy}: render {k + 1}: {r['seconds']:.2f} s, "
+              f"{r['rays_per_second'] / 1e6:.2f} M rays/s", flush=True)
+
+    def result(self):
+        runs = self.runs
+        secs = [r["seconds"] for r in runs]
+        med = min(runs, key=lambda r: abs(r["seconds"] - statistics.median(secs)))  # the median run
+        return {
+            "command": f"pathbench render --scene paper-cornell --width {self.size} --height {self.size} "
+                       f"--spp {self.spp} --bounces 2 --sampling nee --strategy {self.strategy}",
+            "seconds": [round(s, 3) for s in secs],
+            "median_seconds": round(statistics.median(secs), 3),
+            "rays_per_sample": runs[0]["rays"]["total"] / runs[0]["paths"],
+            "rays": runs[0]["rays"],
+            "median_rays_per_second": round(statistics.median(r["rays_per_second"] for r in runs)),
+            "threads": med["machine"]["threads"],
+            "git_revision": med.get("git_revision"),
+            "compiler": med.get("compiler"),
+            "peak_host_bytes": med.get("peak_host_bytes"),
+            "image_mean_rgb": med["image_mean_rgb"],
+        }
+
+
+def markdown(res):
+    m, pb = res["mitsuba"], res["pathbench"]
+    spp, px = res["settings"]["spp"], res["settings"]["width"] * res["settings"]["height"]
+    lines = [
+        f"# Mitsuba 3 vs pathbench on {res['machine']['cpu']}",
+        "",
+        f"paper-cornell, {res['settings']['width']}x{res['settings']['height']}, {spp} spp, two bounces "
+        "(Mitsuba `path` max_depth 3; pathbench `--bounces 2 --sampling nee`), box filter, "
+        f"{res['machine']['hardware_threads']} hardware threads, measured {res['date']} "
+        f"(load average before {res['load_average_before']}, after {res['load_average_after']}).",
+    ]
+    load = max((x[0] for x in (res["load_average_before"], res["load_average_after"]) if x), default=0)
+    if load > 0.5 * res["machine"]["hardware_threads"]:
+        lines += ["",
+                  f"**The machine was busy** (1-minute load average up to {load} on "
+                  f"{res['machine']['hardware_threads']} hardware threads): every render was slowed. The renderers ran "
+                  "in interleaved rounds, so the ratio is the informative number; absolute times are not."]
+    lines += [
+        "",
+        "| renderer | median s (runs) | samples/s | rays/s | speed-up over Mitsuba |",
+        "|---|---|---|---|---|",
+    ]
+    ms_med = m["median_seconds"]
+    lines.append(f"| {m['renderer']} {m['variant']} | {ms_med:.2f} ({', '.join(f'{s:.2f}' for s in m['seconds'])}) "
+                 f"| {px * spp / ms_med / 1e6:.2f} M | ~{m['estimated_rays_per_second'] / 1e6:.1f} M (estimate) | 1.00x |")
+    for strategy, r in pb.items():
+        lines.append(f"| pathbench cpu/{strategy} | {r['median_seconds']:.2f} "
+                     f"({', '.join(f'{s:.2f}' for s in r['seconds'])}) | {px * spp / r['median_seconds'] / 1e6:.2f} M "
+                     f"| {r['median_rays_per_second'] / 1e6:.1f} M | {ms_med / r['median_seconds']:.2f}x |")
+    lines += [
+        "",
+        f"Mitsuba's warm-up render (JIT compilation, excluded): {m['warmup_seconds']:.2f} s.",
+        f"Mitsuba rays/s is an estimate: its samples/s x pathbench's measured {m['rays_per_sample_assumed']:.3f} "
+        "rays per sample for the same estimator (Mitsuba does not count rays).",
+        f"Image means (R, G, B): Mitsuba {m['image_mean_rgb']}, pathbench "
+        f"{next(iter(pb.values()))['image_mean_rgb']}.",
+        f"pathbench revision {next(iter(pb.values()))['git_revision']}, {next(iter(pb.values()))['compiler']}.",
+        "",
+        "Re-run: `.venv/bin/python tools/mitsuba_speed.py` (after `scripts/build.sh`).",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--pathbench", default=str(ROOT / "build" / "bin" / "pathbench"))
+    ap.add_argument("--spp", type=int, default=800)
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--strategies", default="pixel,wavefront")
+    ap.add_argument("--out-dir", help="default: results/<machine>")
+    a = ap.parse_args(argv)
+    if not Path(a.pathbench).is_file():
+        sys.exit(f"{a.pathbench}: not built (run scripts/build.sh, or pass --pathbench)")
+
+    res = {
+        "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "machine": {"slug": machine_slug(), "cpu": cpu_model(), "hardware_threads": os.cpu_count()},
+        "settings": {"scene": "paper-cornell", "width": a.size, "height": a.size, "spp": a.spp, "bounces": 2,
+                     "sampling": "nee", "filter": "box", "repeats": a.repeats},
+        "load_average_before": loadavg(),
+    }
+    # Interleaved rounds (Mitsuba, then each pathbench strategy, repeated), so a change
+    # of load during the run falls on every renderer alike.
+    with tempfile.TemporaryDirectory() as tmp:
+        mitsuba = MitsubaRunner(a.spp, a.variant, a.size)
+        ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp) for s in a.strategies.split(",")}
+        for _ in range(a.repeats):
+            mitsuba.run()
+            for r in ours.values():
+                r.run()
+        res["mitsuba"] = mitsuba.result()
+        res["pathbench"] = {s: r.result() for s, r in ours.items()}
+    res["load_average_after"] = loadavg()
+
+    samples = a.size * a.size * a.spp
+    rps = next(iter(res["pathbench"].values()))["rays_per_sample"]
+    m = res["mitsuba"]
+    m["samples_per_second"] = round(samples / m["median_seconds"])
+    m["rays_per_sample_assumed"] = rps
+    m["estimated_rays_per_second"] = round(samples / m["median_seconds"] * rps)
+    m["rays_counted"] = False
+    for r in res["pathbench"].values():
+        r["samples_per_second"] = round(samples / r["median_seconds"])
+        r["speedup_vs_mitsuba"] = round(m["median_seconds"] / r["median_seconds"], 3)
+
+    out = Path(a.out_dir) if a.out_dir else ROOT / "results" / res["machine"]["slug"]
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "mitsuba-vs-pathbench.json").write_text(json.dumps(res, indent=2) + "\n")
+    md = markdown(res)
+    (out / "mitsuba-vs-pathbench.md").write_text(md)
+    print(md)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
