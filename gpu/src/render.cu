@@ -133,10 +133,14 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
   }
   // Segmented sum over runs of equal keys in consecutive lanes (Hillis-Steele: after
   // the step with offset `off`, a lane holds the sum of [lane, lane + 2 off) within
-  // its run).
+  // its run). Runs are told apart by the lane that starts them, not by the key: one
+  // pixel may have several runs in a warp.
+  const uint32_t key_prev = __shfl_up_sync(kFullMask, key, 1);
+  const uint32_t heads = __ballot_sync(kFullMask, lane == 0 || key_prev != key);
+  const uint32_t run = 31u - uint32_t(__clz(heads & (0xFFFFFFFFu >> (31u - lane))));  // latest head <= lane
 #pragma unroll
   for (int off = 1; off < 32; off <<= 1) {
-    const uint32_t k2 = __shfl_down_sync(kFullMask, key, off);
+    const uint32_t r2 = __shfl_down_sync(kFullMask, run, off);
     const long long a0 = __shfl_down_sync(kFullMask, q0, off), a1 = __shfl_down_sync(kFullMask, q1, off),
                     a2 = __shfl_down_sync(kFullMask, q2, off);
     const uint32_t c2 = __shfl_down_sync(kFullMask, cnt, off);
@@ -146,14 +150,13 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
       b1 = __shfl_down_sync(kFullMask, s1, off);
       b2 = __shfl_down_sync(kFullMask, s2, off);
     }
-    if (lane + off < 32 && k2 == key) {
+    if (lane + off < 32 && r2 == run) {
       q0 += a0; q1 += a1; q2 += a2;
       cnt += c2;
       if (kVariance) { s0 += b0; s1 += b1; s2 += b2; }
     }
   }
-  const uint32_t prev = __shfl_up_sync(kFullMask, key, 1);
-  if (key != 0xFFFFFFFFu && (lane == 0 || prev != key)) {
+  if (key != 0xFFFFFFFFu && run == lane) {
     unsigned long long* sum = film.sum + size_t(key) * 3;
     atomicAdd(sum + 0, static_cast<unsigned long long>(q0));
     atomicAdd(sum + 1, static_cast<unsigned long long>(q1));
@@ -209,8 +212,8 @@ struct PathSoA {
 struct ShadowSoA {
   float4* o;        // origin, contribution.x
   float4* d;        // direction (unnormalised, to the light point), contribution.y
-  float4* L;        // radiance of a finished path, contribution.z
-  uint32_t* target;
+  float2* ct;       // contribution.z, target (bits)
+  float4* L;        // radiance of a finished path (written and read only for those)
 };
 constexpr uint32_t kShadowDone = 0x80000000u;  // pixels < 2^31 (RenderSettings::validate)
 
@@ -334,8 +337,8 @@ __global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, 
           const uint32_t k = queue_push(&ctr->n_shadow);
           sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
           sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
-          sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, q.contribution.z);
-          sh.target[k] = target;
+          sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
+          if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, 0.0f);
         } else if (ev == PathEvent::Done) {
           add = true;
           L_add = st.L;
@@ -357,19 +360,21 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
     uint32_t pixel = 0;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (i < n) {
-      const float4 o = sh.o[i], d = sh.d[i], l = sh.L[i];
-      const uint32_t target = sh.target[i];
+      const float4 o = sh.o[i], d = sh.d[i];
+      const float2 ct = sh.ct[i];
+      const uint32_t target = __float_as_uint(ct.y);
       const bool visible = !occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f);
       if (target & kShadowDone) {
+        const float4 l = sh.L[i];
         L = {l.x, l.y, l.z};
-        if (visible) L = L + Vec3f{o.w, d.w, l.w};  // shadow_unoccluded: L += contribution
+        if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
         add = true;
         pixel = target & ~kShadowDone;
       } else if (visible) {
         float4 Lt = next.L[target];
         Lt.x = Lt.x + o.w;
         Lt.y = Lt.y + d.w;
-        Lt.z = Lt.z + l.w;
+        Lt.z = Lt.z + ct.x;
         next.L[target] = Lt;
       }
     }
@@ -591,8 +596,8 @@ class PathPool {
     if (shadows) {
       sh_o_.allocate(capacity, what, lower);
       sh_d_.allocate(capacity, what, lower);
+      sh_ct_.allocate(capacity, what, lower);
       sh_L_.allocate(capacity, what, lower);
-      sh_target_.allocate(capacity, what, lower);
     }
     ctr_.allocate(1, what, lower);
     PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(WaveCounters)));
@@ -604,13 +609,13 @@ class PathPool {
   // Per path: two state buffers (current and next), the hit, and with light sampling
   // one shadow ray.
   static uint64_t state_bytes(bool shadows) {
-    return 2 * Buffers::bytes_per_path() + sizeof(uint32_t) + (shadows ? 3 * sizeof(float4) + sizeof(uint32_t) : 0);
+    return 2 * Buffers::bytes_per_path() + sizeof(uint32_t) + (shadows ? 3 * sizeof(float4) + sizeof(float2) : 0);
   }
 
   FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                   uint64_t total, FilmDev film, bool variance) {
     PB_CUDA_CHECK(cudaMemsetAsync(ctr_.get(), 0, sizeof(WaveCounters), stream));
-    const ShadowSoA sh{sh_o_.get(), sh_d_.get(), sh_L_.get(), sh_target_.get()};
+    const ShadowSoA sh{sh_o_.get(), sh_d_.get(), sh_ct_.get(), sh_L_.get()};
     WaveCounters* ctr = ctr_.get();
     const uint32_t cap = uint32_t(capacity_);
     FrameResult r;
@@ -664,7 +669,7 @@ class PathPool {
   Buffers buf_[2];
   DeviceBuffer<uint32_t> prim_;
   DeviceBuffer<float4> sh_o_, sh_d_, sh_L_;
-  DeviceBuffer<uint32_t> sh_target_;
+  DeviceBuffer<float2> sh_ct_;
   DeviceBuffer<WaveCounters> ctr_;
   WaveCounters* host_ctr_ = nullptr;
 };
@@ -821,7 +826,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;
   x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
   if (settings.strategy != Strategy::Pixel) {
-    x["state_layout"] = shadows ? "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32 + shadow (3 float4 + u32)"
+    x["state_layout"] = shadows ? "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32 + shadow (o, d: float4; c.z+target: float2; L of a finished path: float4)"
                                 : "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32";
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
