@@ -67,6 +67,11 @@ template <class T> class DeviceBuffer {
     p_ = nullptr;
     n_ = 0;
   }
+  // Allocates v.size() elements and copies v into them.
+  void assign(const std::vector<T>& v, const char* what, const char* lower) {
+    allocate(v.size(), what, lower);
+    upload(v.data(), v.size());
+  }
   void upload(const T* src, uint64_t n) {
     if (n) PB_CUDA_CHECK(cudaMemcpy(p_, src, n * sizeof(T), cudaMemcpyHostToDevice));
   }

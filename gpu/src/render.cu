@@ -401,11 +401,21 @@ std::string kernel_driver_version() {
   std::string v;
   if (std::fgets(line, sizeof line, f)) {
     const std::string l = line;
+    // "NVRM version: NVIDIA UNIX [Open ]Kernel Module [for x86_64]  580.159.04  ...": the
+    // first token after "Kernel Module" that starts with a digit and holds a dot.
     const size_t k = l.find("Kernel Module");
-    if (k != std::string::npos) {
-      size_t a = l.find_first_of("0123456789", k);
-      size_t b = a == std::string::npos ? a : l.find_first_of(" \t\n", a);
-      if (a != std::string::npos) v = l.substr(a, b == std::string::npos ? std::string::npos : b - a);
+    size_t pos = k == std::string::npos ? 0 : k;
+    while (pos < l.size()) {
+      const size_t a = l.find_first_not_of(" \t\n", pos);
+      if (a == std::string::npos) break;
+      const size_t b = l.find_first_of(" \t\n", a);
+      const std::string tok = l.substr(a, b == std::string::npos ? std::string::npos : b - a);
+      if (std::isdigit(static_cast<unsigned char>(tok[0])) && tok.find('.') != std::string::npos) {
+        v = tok;
+        break;
+      }
+      if (b == std::string::npos) break;
+      pos = b;
     }
   }
   std::fclose(f);
@@ -521,22 +531,14 @@ GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   const BvhHost bvh = build_bvh(scene);
   const auto t0 = std::chrono::steady_clock::now();
   const char* lower = "the scene's size (fewer triangles)";
-  m.positions.allocate(scene.positions.size(), "scene vertices", lower);
-  m.positions.upload(scene.positions.data(), scene.positions.size());
-  m.triangles.allocate(scene.triangles.size(), "scene triangles", lower);
-  m.triangles.upload(scene.triangles.data(), scene.triangles.size());
-  m.material_ids.allocate(scene.material_ids.size(), "material ids", lower);
-  m.material_ids.upload(scene.material_ids.data(), scene.material_ids.size());
-  m.materials.allocate(scene.materials.size(), "materials", lower);
-  m.materials.upload(scene.materials.data(), scene.materials.size());
-  m.emitters.allocate(scene.emitters.size(), "emitter table", lower);
-  m.emitters.upload(scene.emitters.data(), scene.emitters.size());
-  m.emitter_cdf.allocate(scene.emitter_cdf.size(), "emitter table", lower);
-  m.emitter_cdf.upload(scene.emitter_cdf.data(), scene.emitter_cdf.size());
-  m.nodes.allocate(bvh.nodes.size(), "BVH nodes", lower);
-  m.nodes.upload(bvh.nodes.data(), bvh.nodes.size());
-  m.tris.allocate(bvh.tris.size(), "BVH triangles", lower);
-  m.tris.upload(bvh.tris.data(), bvh.tris.size());
+  m.positions.assign(scene.positions, "scene vertices", lower);
+  m.triangles.assign(scene.triangles, "scene triangles", lower);
+  m.material_ids.assign(scene.material_ids, "material ids", lower);
+  m.materials.assign(scene.materials, "materials", lower);
+  m.emitters.assign(scene.emitters, "emitter table", lower);
+  m.emitter_cdf.assign(scene.emitter_cdf, "emitter table", lower);
+  m.nodes.assign(bvh.nodes, "BVH nodes", lower);
+  m.tris.assign(bvh.tris, "BVH triangles", lower);
   m.view = scene.view();
   m.view.positions = m.positions.get();
   m.view.triangles = m.triangles.get();
