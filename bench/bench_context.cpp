@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 
@@ -69,7 +70,13 @@ void add_environment_context(const std::string& preset) {
   add("cxx_flags", PATHBENCH_BENCH_CXX_FLAGS);
   add("build_type", PATHBENCH_BENCH_BUILD_TYPE);
   add("embree_version", RTC_VERSION_STRING);
-  add("git_revision", git_revision());
+  // A copy of the tree without .git (a GPU host) has no revision of its own; the
+  // copier may name the source commit in PATHBENCH_SOURCE_COMMIT.
+  std::string rev = git_revision();
+  const char* source_commit = std::getenv("PATHBENCH_SOURCE_COMMIT");
+  if ((rev.empty() || rev == "unknown") && source_commit && *source_commit)
+    rev = std::string(source_commit) + " (PATHBENCH_SOURCE_COMMIT; the tree may have had uncommitted changes)";
+  add("git_revision", rev.empty() ? "unknown" : rev);
   add("date_utc", utc_now());
   add("load_average_at_start", first_line("/proc/loadavg"));
   add_gpu_context();
