@@ -2,7 +2,10 @@
 // SKIPPED with the reason, and CTest counts it as passed.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
+#include <ostream>
+#include <string>
 #include <cstdio>
 
 #include "pathbench/common/errors.h"
@@ -62,6 +65,10 @@ struct StrategyCase {
   int bounces;  // -1: unbounded with Russian roulette
 };
 
+void PrintTo(const StrategyCase& c, std::ostream* os) {
+  *os << c.scene << " " << to_string(c.sampling) << " " << c.bounces;
+}
+
 class GpuStrategies : public ::testing::TestWithParam<StrategyCase> {};
 
 // pixel, wavefront (small pool: many refills) and paper-queue: bit-identical films.
@@ -96,7 +103,14 @@ INSTANTIATE_TEST_SUITE_P(Cases, GpuStrategies,
                                            StrategyCase{"paper-cornell", Sampling::Uniform, 2},
                                            StrategyCase{"paper-cornell", Sampling::Cosine, -1},
                                            StrategyCase{"cornell-box", Sampling::Nee, -1},
-                                           StrategyCase{"paper-cornell-ico:3", Sampling::Nee, 3}));
+                                           StrategyCase{"paper-cornell-ico:3", Sampling::Nee, 3}),
+                         [](const auto& info) {
+                           std::string n = std::string(info.param.scene) + "_" + to_string(info.param.sampling) + "_" +
+                                           (info.param.bounces < 0 ? std::string("rr") : std::to_string(info.param.bounces));
+                           for (char& ch : n)
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           return n;
+                         });
 
 // GPU against the CPU tracer, same seed and settings: with one random stream the
 // images differ only where rounding sends a path to another triangle.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <ostream>
 #include <random>
 
 #include "pathbench/common/errors.h"
@@ -23,6 +24,8 @@ struct SceneCase {
   const char* name;
   bool closed;  // every ray from inside must hit something
 };
+
+void PrintTo(const SceneCase& c, std::ostream* os) { *os << c.name << (c.closed ? " (closed)" : ""); }
 
 Scene load_or_skip(const char* name, bool& ok) {
   ok = true;
