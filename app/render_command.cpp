@@ -18,6 +18,8 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   auto* b = cmd.add_option("--bounces", o.settings.max_bounces, "diffuse bounces (the paper: 2)")->capture_default_str();
   cmd.add_flag("--converged", o.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
   cmd.add_flag("--rr,!--no-rr", o.settings.russian_roulette, "Russian roulette (default: only with --converged)");
+  cmd.add_flag("--watertight,!--no-watertight", o.settings.watertight,
+               "watertight ray/triangle test (default on; off is faster on the CPU and can leak at edges)");
   cmd.add_option("--sampling", o.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
   cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
   cmd.add_option("--strategy", o.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();

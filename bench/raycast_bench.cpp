@@ -177,7 +177,7 @@ void run_raycast(benchmark::State& state, const RaycastCase& c, Api api, bool co
     if (!prep) {
       std::shared_ptr<const Scene> scene = cached_scene(c.scene);
       prep = std::make_shared<Prepared>();
-      prep->embree = std::make_unique<cpu::EmbreeScene>(*scene);
+      prep->embree = std::make_unique<cpu::EmbreeScene>(*scene, /*watertight=*/true);  // as the tracers run by default
       prep->rays = make_ray_sets(*scene, *prep->embree, c.width, c.height);
       store_extra(c.scene, kind, prep);
     }

@@ -25,6 +25,7 @@ nlohmann::json RunReport::to_json() const {
   j["bounces"] = settings.max_bounces < 0 ? nlohmann::json("unbounded") : nlohmann::json(settings.max_bounces);
   j["russian_roulette"] = settings.russian_roulette;
   j["sampling"] = to_string(settings.sampling);
+  j["watertight"] = settings.watertight;
   j["device"] = to_string(settings.device);
   j["strategy"] = to_string(settings.strategy);
   j["seed"] = settings.seed;

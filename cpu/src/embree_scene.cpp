@@ -1,5 +1,7 @@
 #include "embree_scene.h"
 
+#include "pathbench/cpu/embree_flags.h"
+
 #include <fmt/core.h>
 
 #include <cstring>
@@ -22,12 +24,13 @@ bool EmbreeScene::monitor(void* self_ptr, ssize_t bytes, bool) {
   return true;
 }
 
-EmbreeScene::EmbreeScene(const Scene& s) {
+EmbreeScene::EmbreeScene(const Scene& s, bool watertight) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
   rtcSetDeviceErrorFunction(device_, on_error, nullptr);
   rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeScene::monitor, this);
   scene_ = rtcNewScene(device_);
+  rtcSetSceneFlags(scene_, embree_scene_flags(watertight));
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,

@@ -12,7 +12,7 @@ namespace pb::cpu {
 
 class EmbreeScene {
  public:
-  explicit EmbreeScene(const Scene& scene);
+  EmbreeScene(const Scene& scene, bool watertight);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;

@@ -27,7 +27,7 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
   const int threads = settings.threads > 0 ? settings.threads : tbb::this_task_arena::max_concurrency();
 
-  EmbreeScene embree(scene);
+  EmbreeScene embree(scene, settings.watertight);
   film.begin(settings.spp, scene.max_emission());
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
                     settings.total_samples(), settings.progress);

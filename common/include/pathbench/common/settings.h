@@ -39,6 +39,7 @@ struct RenderSettings {
   uint64_t paths_in_flight = 0;  // wavefront pool size; 0 = the device's default
   int threads = 0;               // CPU threads; 0 = all
   bool variance = false;         // also accumulate per-pixel variance
+  bool watertight = true;        // watertight ray/triangle test (CPU: Embree's robust mode)
   bool progress = true;
 
   PathConfig path_config() const {
