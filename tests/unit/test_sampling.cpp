@@ -30,9 +30,9 @@ constexpr int kChiSquareTests = 10;
 const double kAlpha = stat::sidak_alpha(0.01, kChiSquareTests);
 constexpr uint32_t kSamples = 1000000;
 
-// The i-th draw of four uniforms at path vertex 1, dimension group `group` (1: the
-// group the path step uses for the BSDF direction and the emitter choice).
-std::array<float, 4> draw(uint32_t i, uint32_t pixel = 12345, uint32_t group = 1, uint64_t seed = 7) {
+// The i-th draw of four uniforms at path vertex 1 in dimension group `group` (by
+// default the one the path step uses for the BSDF direction and the light sample).
+std::array<float, 4> draw(uint32_t i, uint32_t pixel = 12345, uint32_t group = kRngVertex, uint64_t seed = 7) {
   const Uniform4 u = RngStream{pixel, seed}.draw(i, 1, group);
   return {u.v[0], u.v[1], u.v[2], u.v[3]};
 }
@@ -68,27 +68,16 @@ struct SphereHistogram {
 
 Vec3d to_d(Vec3f v) { return Vec3d(v); }
 
-// pick_emitter(s, u) either takes u by value, or by reference and rescales it to
-// [0, 1) within the chosen emitter's CDF interval so the same number can place the
-// point (sample reuse). The tests follow whichever the path step has.
-template <class S> concept PickRescalesU = !requires(const S& s) { pick_emitter(s, 0.5f); };
-constexpr bool kPickRescales = PickRescalesU<SceneView>;
-
+// pick_emitter(s, u) chooses an emitter and rescales u to [0, 1) within the chosen
+// emitter's CDF interval, so the same number can place the point (sample reuse).
 uint32_t pick(const SceneView& s, float u) { return pick_emitter(s, u); }
 
 // The emitter triangle and barycentrics that path_hit's light sampling derives from
 // the vertex draw `u` (see path.h).
-std::pair<uint32_t, Barycentrics<float>> light_sample(const SceneView& s, const Uniform4& u, uint32_t pixel,
-                                                      uint32_t sample) {
-  if constexpr (kPickRescales) {
-    float u_pick = u.v[2];
-    const uint32_t tri = s.emitters[pick_emitter(s, u_pick)];
-    return {tri, sample_uniform_triangle(u_pick, u.v[3])};
-  } else {
-    const uint32_t tri = s.emitters[pick(s, u.v[3])];
-    const Uniform4 ul = RngStream{pixel, 5}.draw(sample, 1, 2);
-    return {tri, sample_uniform_triangle(ul.v[0], ul.v[1])};
-  }
+std::pair<uint32_t, Barycentrics<float>> light_sample(const SceneView& s, const Uniform4& u) {
+  float u_pick = u.v[2];
+  const uint32_t tri = s.emitters[pick_emitter(s, u_pick)];
+  return {tri, sample_uniform_triangle(u_pick, u.v[3])};
 }
 
 void expect_chi_square_passes(const std::vector<double>& observed, const std::vector<double>& expected,
@@ -258,7 +247,7 @@ TEST(Sampling, UniformTriangleMatchesArea) {
   const int n = 40;
   std::vector<double> obs(n * n, 0.0), e(n * n, 0.0);
   for (uint32_t i = 0; i < kSamples; ++i) {
-    const auto u = draw(i, 4242, 2);
+    const auto u = draw(i, 4242, 3);  // a dimension group of its own
     const Barycentrics<float> b = sample_uniform_triangle(u[0], u[1]);
     ASSERT_GE(b.b1, 0.0f);
     ASSERT_GE(b.b2, 0.0f);
@@ -282,7 +271,7 @@ TEST(Sampling, LightPointsUniformOverPaperLight) {
   std::vector<double> obs(nx * nz, 0.0);
   for (uint32_t i = 0; i < kSamples; ++i) {
     const uint32_t pixel = i % 4096, sample = i / 4096;
-    const auto [tri_id, b] = light_sample(s, RngStream{pixel, 5}.draw(sample, 1, 1), pixel, sample);
+    const auto [tri_id, b] = light_sample(s, RngStream{pixel, 5}.draw(sample, 1, kRngVertex));
     const Triangle tri = s.triangles[tri_id];
     const Vec3f v0 = s.positions[tri.v[0]];
     const Vec3f y = v0 + (s.positions[tri.v[1]] - v0) * b.b1 + (s.positions[tri.v[2]] - v0) * b.b2;
@@ -368,8 +357,8 @@ TEST(PickEmitter, FrequenciesFollowTheCdf) {
     EXPECT_NEAR(s.emitter_cdf[i], acc / 2.75, 1e-6) << "emitter " << i;
   }
   // Histogram over (emitter, u after the pick): the emitter frequencies follow the CDF
-  // and, where pick_emitter rescales u, the rescaled u is uniform on [0, 1) for each.
-  const int nu = kPickRescales ? 50 : 1;
+  // and the rescaled u is uniform on [0, 1) for each emitter.
+  const int nu = 50;
   std::vector<double> obs(3 * nu, 0.0), e(3 * nu);
   for (uint32_t i = 0; i < kSamples; ++i) {
     float u = draw(i, 31337)[2];
@@ -380,7 +369,7 @@ TEST(PickEmitter, FrequenciesFollowTheCdf) {
     obs[k * nu + std::min(nu - 1, int(u * nu))] += 1;
   }
   for (int i = 0; i < 3 * nu; ++i) e[i] = kSamples * power[i / nu] / 2.75 / nu;
-  expect_chi_square_passes(obs, e, kPickRescales ? "pick_emitter (choice and rescaled u)" : "pick_emitter");
+  expect_chi_square_passes(obs, e, "pick_emitter (choice and rescaled u)");
 }
 
 TEST(PickEmitter, EdgesOfTheCdf) {
@@ -390,14 +379,12 @@ TEST(PickEmitter, EdgesOfTheCdf) {
   EXPECT_EQ(pick(s, std::nextafter(s.emitter_cdf[0], 0.0f)), 0u);
   EXPECT_EQ(pick(s, s.emitter_cdf[0]), 1u);  // intervals are [cdf[i-1], cdf[i])
   EXPECT_EQ(pick(s, 1.0f - 1.0f / 16777216.0f), 2u);
-  if constexpr (kPickRescales) {
-    float u = 1.0f - 1.0f / 16777216.0f;
-    pick_emitter(s, u);
-    EXPECT_LT(u, 1.0f) << "the rescaled u must stay below 1";
-    u = s.emitter_cdf[0];
-    pick_emitter(s, u);
-    EXPECT_EQ(u, 0.0f);
-  }
+  float u = 1.0f - 1.0f / 16777216.0f;
+  pick_emitter(s, u);
+  EXPECT_LT(u, 1.0f) << "the rescaled u must stay below 1";
+  u = s.emitter_cdf[0];
+  pick_emitter(s, u);
+  EXPECT_EQ(u, 0.0f);
   // One emitter: always it.
   const Scene cornell = make_paper_cornell();
   Scene one = cornell;
