@@ -11,9 +11,10 @@
 #include <limits>
 #include <memory>
 
-#include "embree_scene.h"  // cpu/src: the tracer's own Embree scene
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
+#include "pathbench/common/settings.h"
+#include "pathbench/cpu/embree_scene.h"  // the tracer's own Embree scene
 #include "scene_cache.h"
 
 namespace pb::bench {
@@ -177,7 +178,7 @@ void run_raycast(benchmark::State& state, const RaycastCase& c, Api api, bool co
     if (!prep) {
       std::shared_ptr<const Scene> scene = cached_scene(c.scene);
       prep = std::make_shared<Prepared>();
-      prep->embree = std::make_unique<cpu::EmbreeScene>(*scene, /*watertight=*/true);  // as the tracers run by default
+      prep->embree = std::make_unique<cpu::EmbreeScene>(*scene, RenderSettings{}.watertight);  // as the tracers run by default
       prep->rays = make_ray_sets(*scene, *prep->embree, c.width, c.height);
       store_extra(c.scene, kind, prep);
     }
