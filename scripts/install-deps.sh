@@ -9,7 +9,8 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 apt_pkgs=(build-essential cmake ninja-build pkg-config git python3 python3-venv
           libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
           librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
-          libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev)
+          libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev
+          libllvm19)  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison
 missing=()
 for p in "${apt_pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

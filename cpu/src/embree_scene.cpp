@@ -1,4 +1,4 @@
-#include "embree_scene.h"
+#include "pathbench/cpu/embree_scene.h"
 
 #include "pathbench/cpu/embree_flags.h"
 

@@ -7,7 +7,7 @@
 #include <chrono>
 #include <memory>
 
-#include "embree_scene.h"
+#include "pathbench/cpu/embree_scene.h"
 #include "pathbench/common/errors.h"
 #include "strategies.h"
 

@@ -4,7 +4,7 @@
 #include <atomic>
 #include <cstdint>
 
-#include "embree_scene.h"
+#include "pathbench/cpu/embree_scene.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/progress.h"
 #include "pathbench/common/report.h"

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pathbench/common/scene.h"
+#include "pathbench/cpu/embree_scene.h"
 #include "pathbench/gpu/bvh.h"
 
 namespace pb::gpu::test {
@@ -26,28 +27,10 @@ struct Hit {
   float t = 0;
 };
 
-// Embree's answers on the same scene.
+// Embree's answers on the same scene, built as the CPU tracer builds it (watertight).
 class EmbreeReference {
  public:
-  explicit EmbreeReference(const Scene& s) {
-    device_ = rtcNewDevice("");
-    scene_ = rtcNewScene(device_);
-    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), s.positions.size()));
-    std::memcpy(v, s.positions.data(), s.positions.size() * sizeof(Vec3f));
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), s.triangles.size()));
-    std::memcpy(idx, s.triangles.data(), s.triangles.size() * sizeof(Triangle));
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(scene_, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(scene_);
-  }
-  ~EmbreeReference() {
-    rtcReleaseScene(scene_);
-    rtcReleaseDevice(device_);
-  }
+  explicit EmbreeReference(const Scene& s) : embree_(s, /*watertight=*/true), scene_(embree_.handle()) {}
   Hit closest(const Ray3& r) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -82,7 +65,7 @@ class EmbreeReference {
     e.flags = 0;
     e.id = 0;
   }
-  RTCDevice device_;
+  cpu::EmbreeScene embree_;
   RTCScene scene_;
 };
 

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/embree_flags.h"
+#include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/render.h"
 #include "stat_test.h"
 
@@ -133,20 +133,7 @@ TEST(Seams, NoPixelIsADarkValleyBeyondNoise) {
 // hit it: none may slip between two triangles (that would end the path: a black seam).
 TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
   for (const Scene& scene : {make_paper_cornell(), transformed(make_paper_cornell(), 1e3f, {1e4f, 0, 0})}) {
-    RTCDevice dev = rtcNewDevice(nullptr);
-    RTCScene rs = rtcNewScene(dev);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, scene.positions.size()));
-    std::memcpy(v, scene.positions.data(), scene.positions.size() * 12);
-    auto* ix = static_cast<uint32_t*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, scene.triangles.size()));
-    std::memcpy(ix, scene.triangles.data(), scene.triangles.size() * 12);
-    rtcCommitGeometry(g);
-    rtcSetSceneFlags(rs, cpu::embree_scene_flags(true));  // as the CPU tracer builds it by default
-    rtcAttachGeometry(rs, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(rs);
+    const cpu::EmbreeScene embree(scene, /*watertight=*/true);  // as the CPU tracer builds it by default
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
 
@@ -171,12 +158,10 @@ TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
       rh.ray.tfar = std::numeric_limits<float>::infinity();
       rh.ray.mask = ~0u;
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(rs, &ctx, &rh);
+      rtcIntersect1(embree.handle(), &ctx, &rh);
       ++rays;
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) ++misses;
     }
-    rtcReleaseScene(rs);
-    rtcReleaseDevice(dev);
     EXPECT_EQ(misses, 0) << scene.name << ": " << misses << " of " << rays << " rays slipped through an edge";
   }
 }
