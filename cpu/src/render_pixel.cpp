@@ -20,25 +20,30 @@ struct Local {
 Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
   PathState<float> st;
   path_begin(job.scene, job.config, pixel, sample, st);
-  ++local.rays.camera;
+  ShadowQuery<float> q;
+  auto occlusion_test = [&](uint64_t& counter) {
+    RTCRay sr;
+    to_embree(q.ray, 1.0f, sr);
+    rtcOccluded1(job.embree.handle(), &ctx, &sr);
+    ++counter;
+    if (sr.tfar >= 0.0f) shadow_unoccluded(st, q);
+  };
   for (;;) {
+    uint64_t& ray_kind = st.depth == 0 ? local.rays.camera : local.rays.bounce;
+    if (path_at_final_vertex(job.scene, job.config, st)) {  // only emitted light can still count
+      if (path_final_query(job.scene, job.config, st, q)) occlusion_test(st.depth == 0 ? ray_kind : local.rays.shadow);
+      break;
+    }
     RTCRayHit rh;
     to_embree(st.ray, kInfinity, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(job.embree.handle(), &ctx, &rh);
+    ++ray_kind;
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
-    ShadowQuery<float> q;
     bool wants_shadow;
     const PathEvent ev = path_hit(job.scene, job.config, st, surface_hit(job.scene, rh.hit.primID, st.ray), q, wants_shadow);
-    if (wants_shadow) {
-      RTCRay sr;
-      to_embree(q.ray, 1.0f, sr);
-      rtcOccluded1(job.embree.handle(), &ctx, &sr);
-      ++local.rays.shadow;
-      if (sr.tfar >= 0.0f) shadow_unoccluded(st, q);
-    }
+    if (wants_shadow) occlusion_test(local.rays.shadow);
     if (ev == PathEvent::Done) break;
-    ++local.rays.bounce;
   }
   return st.L;
 }

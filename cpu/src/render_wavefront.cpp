@@ -1,7 +1,8 @@
 // Ray-parallel ("wavefront") CPU strategy. Each thread owns a slice of the pool of
 // paths in flight and runs the stages over the whole slice in turn:
-//   generate (fill free slots with new samples) -> intersect (16-wide packets) ->
-//   shade (shared path step) -> shadow (16-wide packets) -> accumulate (film, free slot)
+//   generate (fill free slots with new samples) -> final vertex (paths whose next hit
+//   can only add emission: emitter query instead of a closest hit) -> intersect (8-wide
+//   packets) -> shade (shared path step) -> shadow (8-wide packets) -> accumulate
 // Memory is the pool, fixed by --paths-in-flight, never width x height x spp.
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
@@ -73,7 +74,7 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool, Local& local) {
+void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool) {
   uint64_t n = pool.free.size();
   if (n == 0) return;
   const uint64_t start = src.claim(n);
@@ -83,10 +84,29 @@ void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool, Loc
     path_begin(job.scene, job.config, src.pixel_of(start + i), src.sample_of(start + i), pool.state[slot]);
     pool.live.push_back(slot);
   }
-  local.rays.camera += n;
 }
 
-void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx) {
+// Paths whose next hit could only add emitted light leave the live list here: their
+// occlusion test (if they face an emitter) joins the shadow stage, and they are done.
+void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
+  size_t keep = 0;
+  for (uint32_t slot : pool.live) {
+    const PathState<float>& st = pool.state[slot];
+    if (!path_at_final_vertex(job.scene, job.config, st)) {
+      pool.live[keep++] = slot;
+      continue;
+    }
+    if (path_final_query(job.scene, job.config, st, pool.shadow[slot])) {
+      pool.shadowed.push_back(slot);
+      ++(st.depth == 0 ? local.rays.camera : local.rays.shadow);
+    }
+    pool.done.push_back(slot);
+  }
+  pool.live.resize(keep);
+}
+
+void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local) {
+  for (uint32_t slot : pool.live) ++(pool.state[slot].depth == 0 ? local.rays.camera : local.rays.bounce);
   alignas(64) RTCRayHitNt<kPacket> packet;
   alignas(64) int valid[kPacket];
   for (size_t base = 0; base < pool.live.size(); base += kPacket) {
@@ -105,7 +125,6 @@ void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& 
 
 void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
   pool.next_live.clear();
-  pool.shadowed.clear();
   for (uint32_t slot : pool.live) {
     PathState<float>& st = pool.state[slot];
     if (pool.prim[slot] == RTC_INVALID_GEOMETRY_ID) {
@@ -119,11 +138,11 @@ void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
     if (ev == PathEvent::Continue) pool.next_live.push_back(slot);
     else pool.done.push_back(slot);
   }
-  local.rays.bounce += pool.next_live.size();
   std::swap(pool.live, pool.next_live);
 }
 
-void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local) {
+// `finals`: how many of the shadowed paths are final-vertex queries (counted there).
+void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local, size_t finals) {
   alignas(64) RTCRayNt<kPacket> packet;
   alignas(64) int valid[kPacket];
   for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
@@ -138,7 +157,8 @@ void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx
       if (packet.tfar[i] >= 0.0f) shadow_unoccluded(pool.state[slot], pool.shadow[slot]);
     }
   }
-  local.rays.shadow += pool.shadowed.size();
+  local.rays.shadow += pool.shadowed.size() - finals;
+  pool.shadowed.clear();
 }
 
 void stage_accumulate(const TraceJob& job, PoolSlice& pool, Local& local) {
@@ -166,11 +186,13 @@ TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
-      stage_generate(job, source, pool, local);
+      stage_generate(job, source, pool);
       if (pool.live.empty()) break;
-      stage_intersect(job, pool, ctx);
+      stage_final_vertex(job, pool, local);
+      const size_t finals = pool.shadowed.size();
+      stage_intersect(job, pool, ctx, local);
       stage_shade(job, pool, local);
-      stage_shadow(job, pool, ctx, local);
+      stage_shadow(job, pool, ctx, local, finals);
       stage_accumulate(job, pool, local);
     }
   }, tbb::static_partitioner());

@@ -5,7 +5,9 @@
 //   3. calls path_hit with that hit, which adds emission, may ask for one shadow
 //      ray, samples the next direction and applies Russian roulette,
 //   4. traces the shadow ray, if any, and calls shadow_unoccluded when it is clear,
-//   5. loops to 2 while path_hit says Continue, then hands path_radiance to the film.
+//   5. loops to 2 while path_hit says Continue, then hands the path's L to the film.
+// At the last vertex of a bounded path a tracer may replace 2-4 with path_final_query
+// and one occlusion test (below).
 // Everything random comes from the (seed, pixel, sample, bounce) stream, so the order
 // in which a tracer runs these steps across paths cannot change the image.
 #include <cstdint>
@@ -17,6 +19,7 @@
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
 #include "pathbench/common/surface_hit.h"
+#include "pathbench/common/watertight.h"
 
 namespace pb {
 
@@ -75,6 +78,19 @@ PB_HD uint32_t pick_emitter(const SceneView& s, float& u) {
   return lo;
 }
 
+// What the path gains from emission `Le` seen at hit `h` (front side, cosine cos_o):
+// beta Le, weighted by MIS against light sampling when that could have found it too.
+template <class T>
+PB_HD Vec3<T> emitted_radiance(const SceneView& s, const PathConfig& c, const PathState<T>& st, const SurfaceHit<T>& h,
+                               Vec3f Le, T cos_o) {
+  T w = T(1);
+  if (c.sampling == Sampling::Nee && st.depth > 0) {
+    T pdf_light = emitter_area_pdf<T>(s, Le) * h.t * h.t / cos_o;
+    w = power_heuristic(st.bsdf_pdf, pdf_light);
+  }
+  return st.beta * Vec3<T>(Le) * w;
+}
+
 template <class T>
 PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& st, const SurfaceHit<T>& h,
                          ShadowQuery<T>& shadow, bool& wants_shadow) {
@@ -84,14 +100,7 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
 
   // 1. Emission (one-sided), weighted against light sampling when that could have
   //    found this point too.
-  if (cos_o > T(0) && !is_zero(m.emission)) {
-    T w = T(1);
-    if (c.sampling == Sampling::Nee && st.depth > 0) {
-      T pdf_light = emitter_area_pdf<T>(s, m.emission) * h.t * h.t / cos_o;
-      w = power_heuristic(st.bsdf_pdf, pdf_light);
-    }
-    st.L += st.beta * Vec3<T>(m.emission) * w;
-  }
+  if (cos_o > T(0) && !is_zero(m.emission)) st.L += emitted_radiance(s, c, st, h, m.emission, cos_o);
 
   // 2. The bounce budget is spent, or the surface does not reflect.
   if (c.max_bounces >= 0 && st.depth >= uint32_t(c.max_bounces)) return PathEvent::Done;
@@ -155,6 +164,46 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
   st.bsdf_pdf = pdf;
   st.depth = vertex;
   return PathEvent::Continue;
+}
+
+// ---- The last vertex of a bounded path --------------------------------------------
+// Once the bounce budget is spent, the next hit can only add emitted light. A tracer
+// may then skip the closest-hit query: path_final_query finds the closest emitter
+// along the ray itself (watertight test against each emitter triangle) and asks for
+// one occlusion test up to it. The path gains exactly what path_hit would add if that
+// emitter were the closest hit, and for most rays (those that miss every emitter) no
+// ray is traced at all. Used only where emitters are few enough to test one by one.
+constexpr uint32_t kMaxEmittersForFinalQuery = 16;
+
+template <class T>
+PB_HD bool path_at_final_vertex(const SceneView& s, const PathConfig& c, const PathState<T>& st) {
+  return c.max_bounces >= 0 && st.depth >= uint32_t(c.max_bounces) && s.num_emitters <= kMaxEmittersForFinalQuery;
+}
+
+// Returns true and fills `q` when an emitter facing the ray lies along it; the path is
+// done either way.
+template <class T>
+PB_HD bool path_final_query(const SceneView& s, const PathConfig& c, const PathState<T>& st, ShadowQuery<T>& q) {
+  const WatertightRay wr = make_watertight_ray(Vec3f(st.ray.o), Vec3f(st.ray.d));
+  float closest = 3.402823466e38f;
+  uint32_t prim = ~0u;
+  for (uint32_t k = 0; k < s.num_emitters; ++k) {
+    const uint32_t id = s.emitters[k];
+    const Triangle t = s.triangles[id];
+    float th;
+    if (intersect_watertight(wr, s.positions[t.v[0]], s.positions[t.v[1]], s.positions[t.v[2]], closest, th)) {
+      closest = th;
+      prim = id;
+    }
+  }
+  if (prim == ~0u) return false;
+  const SurfaceHit<T> h = surface_hit(s, prim, st.ray);
+  const T cos_o = -dot(h.ng, st.ray.d);
+  const Vec3f Le = s.material_of(prim).emission;
+  if (!(cos_o > T(0)) || is_zero(Le)) return false;
+  q.contribution = emitted_radiance(s, c, st, h, Le, cos_o);
+  q.ray = {st.ray.o, offset_ray_origin(h.p, h.ng, s.offset) - st.ray.o};  // up to just in front of it
+  return true;
 }
 
 template <class T> PB_HD void shadow_unoccluded(PathState<T>& st, const ShadowQuery<T>& q) {

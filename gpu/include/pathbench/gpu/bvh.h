@@ -8,7 +8,7 @@
 
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
-#include "pathbench/gpu/watertight.h"
+#include "pathbench/common/watertight.h"
 
 namespace pb::gpu {
 

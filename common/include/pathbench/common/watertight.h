@@ -13,7 +13,7 @@
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
 
-namespace pb::gpu {
+namespace pb {
 
 // Per-ray constants of the shear transform.
 struct WatertightRay {
@@ -80,4 +80,4 @@ PB_HD bool intersect_watertight(const WatertightRay& r, const Vec3f& a, const Ve
   return t > 0.0f && t < t_max;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb
