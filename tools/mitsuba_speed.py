@@ -87,25 +87,37 @@ class MitsubaRunner:
         }
 
 
-class PathbenchRunner:
-    """`pathbench render` on paper-cornell with one strategy; its own report's seconds."""
+# Rays per sample of this estimator when every segment is a closest-hit or shadow query
+# (camera ray; at each of the first two hits a shadow ray and a continuation ray), as
+# pathbench measured it at commit 3d3ac70, before it answered the last continuation ray
+# with an emitter test. Mitsuba traces every segment, and does not count its rays.
+FULL_TRACE_RAYS_PER_SAMPLE = 4.504
 
-    def __init__(self, binary, strategy, spp, size, tmp):
-        self.binary, self.strategy, self.spp, self.size, self.tmp = binary, strategy, spp, size, Path(tmp)
+
+class PathbenchRunner:
+    """`pathbench render` on paper-cornell with one strategy; its own report's seconds.
+    `spec` is a strategy, optionally with flags after '/': "wavefront/no-watertight"."""
+
+    def __init__(self, binary, spec, spp, size, tmp):
+        self.strategy, *flags = spec.split("/")
+        self.flags = [f"--{f}" for f in flags]
+        self.label = spec
+        self.binary, self.spp, self.size, self.tmp = binary, spp, size, Path(tmp)
         self.runs = []
 
     def run(self):
         k = len(self.runs)
-        report = self.tmp / f"{self.strategy}-{k}.json"
-        image = self.tmp / f"{self.strategy}-{k}.pfm"
+        name = self.label.replace("/", "-")
+        report = self.tmp / f"{name}-{k}.json"
+        image = self.tmp / f"{name}-{k}.pfm"
         cmd = [str(self.binary), "render", "--scene", "paper-cornell", "--width", str(self.size), "--height",
                str(self.size), "--spp", str(self.spp), "--bounces", "2", "--sampling", "nee", "--strategy",
-               self.strategy, "--seed", str(k + 1), "--out", str(image), "--report", str(report), "--quiet"]
+               self.strategy, *self.flags, "--seed", str(k + 1), "--out", str(image), "--report", str(report), "--quiet"]
         subprocess.run(cmd, check=True)
         r = json.loads(report.read_text())
         r["image_mean_rgb"] = [round(float(x), 5) for x in ms.read_pfm(image).reshape(-1, 3).mean(axis=0)]
         self.runs.append(r)
-        print(f"pathbench {self.strategy}: render {k + 1}: {r['seconds']:.2f} s, "
+        print(f"pathbench {self.label}: render {k + 1}: {r['seconds']:.2f} s, "
               f"{r['rays_per_second'] / 1e6:.2f} M rays/s", flush=True)
 
     def result(self):
@@ -114,7 +126,7 @@ class PathbenchRunner:
         med = min(runs, key=lambda r: abs(r["seconds"] - statistics.median(secs)))  # the median run
         return {
             "command": f"pathbench render --scene paper-cornell --width {self.size} --height {self.size} "
-                       f"--spp {self.spp} --bounces 2 --sampling nee --strategy {self.strategy}",
+                       f"--spp {self.spp} --bounces 2 --sampling nee --strategy {self.strategy} {' '.join(self.flags)}".rstrip(),
             "seconds": [round(s, 3) for s in secs],
             "median_seconds": round(statistics.median(secs), 3),
             "rays_per_sample": runs[0]["rays"]["total"] / runs[0]["paths"],
@@ -160,8 +172,10 @@ def markdown(res):
     lines += [
         "",
         f"Mitsuba's warm-up render (JIT compilation, excluded): {m['warmup_seconds']:.2f} s.",
-        f"Mitsuba rays/s is an estimate: its samples/s x pathbench's measured {m['rays_per_sample_assumed']:.3f} "
-        "rays per sample for the same estimator (Mitsuba does not count rays).",
+        f"Mitsuba rays/s is an estimate: its samples/s x {m['rays_per_sample_assumed']:.3f} rays per sample, what "
+        "pathbench measured for this estimator when it traced every segment (Mitsuba does not count rays). pathbench "
+        "now answers the last continuation ray with an emitter test and traces fewer rays per sample (rays/s counts "
+        "only rays traced). `no-watertight`: Embree without its robust mode (faster; rays can slip through edges).",
         f"Image means (R, G, B): Mitsuba {m['image_mean_rgb']}, pathbench "
         f"{next(iter(pb.values()))['image_mean_rgb']}.",
         f"pathbench revision {next(iter(pb.values()))['git_revision']}, {next(iter(pb.values()))['compiler']}.",
@@ -179,7 +193,8 @@ def main(argv=None):
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--variant", default="llvm_ad_rgb")
-    ap.add_argument("--strategies", default="pixel,wavefront")
+    ap.add_argument("--strategies", default="pixel,wavefront,pixel/no-watertight,wavefront/no-watertight",
+                    help="strategies, each optionally with flags after '/' (default: both, watertight or not)")
     ap.add_argument("--out-dir", help="default: results/<machine>")
     a = ap.parse_args(argv)
     if not Path(a.pathbench).is_file():
@@ -206,7 +221,7 @@ def main(argv=None):
     res["load_average_after"] = loadavg()
 
     samples = a.size * a.size * a.spp
-    rps = next(iter(res["pathbench"].values()))["rays_per_sample"]
+    rps = FULL_TRACE_RAYS_PER_SAMPLE
     m = res["mitsuba"]
     m["samples_per_second"] = round(samples / m["median_seconds"])
     m["rays_per_sample_assumed"] = rps
