@@ -864,4 +864,32 @@ std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<T
   return out;
 }
 
+std::vector<double> time_trace_on_device(const GpuScene& gs, const std::vector<TraceQuery>& rays, bool any_hit,
+                                         int repeats) {
+  ensure_device();
+  if (rays.empty() || repeats < 1) throw InputError("time_trace_on_device: needs rays and at least one repeat");
+  const uint32_t n = uint32_t(rays.size());
+  DeviceBuffer<TraceQuery> d_rays(n, "benchmark rays", "the number of rays");
+  DeviceBuffer<TraceResult> d_out(n, "benchmark results", "the number of rays");
+  d_rays.upload(rays.data(), n);
+  Launcher launch(nullptr, false);
+  const ScopedEvent start, stop;
+  std::vector<double> seconds;
+  for (int r = -1; r < repeats; ++r) {  // r = -1: warm-up, not timed
+    PB_CUDA_CHECK(cudaMemset(d_out.get(), 0xAB, sizeof(TraceResult) * n));  // poison
+    PB_CUDA_CHECK(cudaEventRecord(start.e, nullptr));
+    launch.launch("trace", k_trace, n, gs.impl().bvh, d_rays.get(), d_out.get(), n, any_hit);
+    PB_CUDA_CHECK(cudaEventRecord(stop.e, nullptr));
+    PB_CUDA_CHECK(cudaEventSynchronize(stop.e));
+    float ms = 0;
+    PB_CUDA_CHECK(cudaEventElapsedTime(&ms, start.e, stop.e));
+    if (r >= 0) seconds.push_back(double(ms) * 1e-3);
+  }
+  std::vector<TraceResult> out(n);
+  d_out.download(out.data(), n);
+  for (const TraceResult& t : out)
+    if (t.prim == 0xABABABABu) throw std::runtime_error("time_trace_on_device: a result was not written");
+  return seconds;
+}
+
 }  // namespace pb::gpu

@@ -72,4 +72,11 @@ struct TraceResult {
 };
 std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit);
 
+// Ray casting alone, for the raw ray-cast benchmarks: the rays are uploaded once, the
+// traversal kernel runs once to warm up, then `repeats` launches are each timed with
+// CUDA events. Returns the device seconds of each timed launch. Throws if any result
+// was left unwritten (the output is poisoned before every launch).
+std::vector<double> time_trace_on_device(const GpuScene& scene, const std::vector<TraceQuery>& rays, bool any_hit,
+                                         int repeats);
+
 }  // namespace pb::gpu
