@@ -61,7 +61,9 @@ void register_paper_cornell(uint32_t side, uint32_t spp, uint32_t raycast_side) 
       for (Strategy strat : strategies(dev))
         register_render_benchmark(render_case("paper-cornell", dev, strat, side, side, spp, 2, sampling));
   register_raycast_benchmarks({"paper-cornell", raycast_side, raycast_side});
-  // GPU BVH ray casts (raycast/gpu/...) register here once the GPU tracer has them.
+#if PATHBENCH_BENCH_GPU
+  register_gpu_raycast_benchmarks({"paper-cornell", raycast_side, raycast_side});
+#endif
 }
 
 void preset_quick() { register_paper_cornell(64, 4, 128); }
@@ -81,8 +83,13 @@ void preset_scaling() {
     const std::string scene = fmt::format("scaling:{}", n);
     const uint32_t side = n >= 1000000 ? 64 : 128;
     for (Device dev : devices())
-      for (Strategy strat : strategies(dev))
-        register_render_benchmark(render_case(scene, dev, strat, side, side, 8, 2, Sampling::Nee));
+      for (Strategy strat : strategies(dev)) {
+        RenderCase c = render_case(scene, dev, strat, side, side, 8, 2, Sampling::Nee);
+        // Every iteration builds the BVH again, outside the timed render: a fixed
+        // count keeps 10^6..10^7 triangles from taking minutes.
+        c.iterations = 3;
+        register_render_benchmark(c);
+      }
     register_raycast_benchmarks({scene, 256, 256});
   }
   // Time vs spp and vs resolution (and memory vs pixels x spp), paper-cornell, nee.

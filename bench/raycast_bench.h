@@ -15,9 +15,9 @@
 // Embree's ray structures (as a tracer must) and casts them on all TBB threads.
 // Counter rays_per_second (kIsRate, wall time).
 //
-// GPU: the GPU BVH ray-cast benchmarks (raycast/gpu/<kernel>/<coherent|incoherent>/
-// <scene>) belong beside these and are registered from bench_main.cpp where
-// PATHBENCH_BENCH_GPU is set; they can take the same stored rays from make_ray_sets().
+// GPU: the GPU BVH ray-cast benchmarks (raycast/gpu/<closest|any>/<coherent|incoherent>/
+// <scene>, raycast_gpu_bench.cpp) cast the same stored rays from make_ray_sets(); they
+// are registered from bench_main.cpp where PATHBENCH_BENCH_GPU is set.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -48,5 +48,7 @@ struct RaycastCase {
 };
 // Registers every api x {coherent, incoherent} for one scene.
 void register_raycast_benchmarks(const RaycastCase& c);
+// The GPU BVH's: raycast/gpu/<closest|any>/<coherent|incoherent>/<scene> (CUDA builds).
+void register_gpu_raycast_benchmarks(const RaycastCase& c);
 
 }  // namespace pb::bench

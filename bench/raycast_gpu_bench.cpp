@@ -1,0 +1,90 @@
+// Raw ray casts through the GPU BVH (no shading): the GPU tracers' ceiling, beside the
+// Embree ones of raycast_bench.cpp and on the same stored rays.
+//   raycast/gpu/<closest|any>/<coherent|incoherent>/<scene>
+// Each iteration is one launch of the traversal kernel over every ray, timed with CUDA
+// events after a warm-up launch (UseManualTime); the rays are uploaded once.
+#include <benchmark/benchmark.h>
+#include <fmt/core.h>
+
+#include <memory>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/cpu/embree_scene.h"
+#include "pathbench/gpu/render.h"
+#include "raycast_bench.h"
+#include "device_render.h"
+#include "scene_cache.h"
+
+namespace pb::bench {
+
+namespace {
+
+struct GpuPrepared {
+  std::unique_ptr<gpu::GpuScene> scene;
+  std::vector<gpu::TraceQuery> coherent, incoherent;
+};
+
+std::vector<gpu::TraceQuery> to_queries(const RaySet& s, bool any_hit) {
+  std::vector<gpu::TraceQuery> q(s.size());
+  for (size_t i = 0; i < s.size(); ++i)
+    q[i] = {{s.ox[i], s.oy[i], s.oz[i]}, {s.dx[i], s.dy[i], s.dz[i]}, any_hit ? s.t_occluded[i] : 3.402823466e38f};
+  return q;
+}
+
+void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit, bool coherent) {
+  std::string why;
+  if (!app::gpu_available(&why)) {
+    state.SkipWithError(("no GPU: " + why).c_str());
+    return;
+  }
+  std::shared_ptr<GpuPrepared> prep;
+  const std::string kind = fmt::format("gpu-raycast:{}x{}:{}", c.width, c.height, any_hit ? "any" : "closest");
+  try {
+    prep = std::static_pointer_cast<GpuPrepared>(cached_extra(c.scene, kind));
+    if (!prep) {
+      std::shared_ptr<const Scene> scene = cached_scene(c.scene);
+      const cpu::EmbreeScene embree(*scene, RenderSettings{}.watertight);
+      const RaySets rays = make_ray_sets(*scene, embree, c.width, c.height);
+      prep = std::make_shared<GpuPrepared>();
+      prep->scene = std::make_unique<gpu::GpuScene>(*scene);
+      prep->coherent = to_queries(rays.coherent, any_hit);
+      prep->incoherent = to_queries(rays.incoherent, any_hit);
+      store_extra(c.scene, kind, prep);
+    }
+  } catch (const InputError& e) {
+    state.SkipWithError(fmt::format("scene not available: {}", e.what()).c_str());
+    return;
+  }
+  const std::vector<gpu::TraceQuery>& rays = coherent ? prep->coherent : prep->incoherent;
+  if (rays.empty()) {
+    state.SkipWithError("no rays: every camera ray missed the scene");
+    return;
+  }
+  for (auto _ : state) {
+    try {
+      state.SetIterationTime(gpu::time_trace_on_device(*prep->scene, rays, any_hit, 1).front());
+    } catch (const std::exception& e) {
+      state.SkipWithError(e.what());
+      break;
+    }
+  }
+  using benchmark::Counter;
+  state.counters["rays_per_second"] = Counter(double(rays.size()), Counter::kIsIterationInvariantRate);
+  state.counters["rays"] = double(rays.size());
+  state.counters["triangles"] = double(cached_scene(c.scene)->triangles.size());
+}
+
+}  // namespace
+
+void register_gpu_raycast_benchmarks(const RaycastCase& c) {
+  for (bool any_hit : {false, true})
+    for (bool coherent : {true, false}) {
+      const std::string name = fmt::format("raycast/gpu/{}/{}/{}", any_hit ? "any" : "closest",
+                                           coherent ? "coherent" : "incoherent", c.scene);
+      benchmark::RegisterBenchmark(name.c_str(), [c, any_hit, coherent](benchmark::State& st) {
+        run_gpu_raycast(st, c, any_hit, coherent);
+      })->UseManualTime()->Unit(benchmark::kMicrosecond);
+    }
+}
+
+}  // namespace pb::bench
