@@ -97,6 +97,7 @@ void register_render_benchmark(const RenderCase& c) {
   auto* b = benchmark::RegisterBenchmark(render_benchmark_name(copy).c_str(),
                                          [copy](benchmark::State& st) { run_render(st, copy); });
   b->UseManualTime()->Unit(benchmark::kMillisecond);
+  if (copy.iterations > 0) b->Iterations(copy.iterations);
 }
 
 }  // namespace pb::bench

@@ -23,6 +23,8 @@ namespace pb::bench {
 struct RenderCase {
   std::string scene;
   RenderSettings settings;  // device, strategy, size, spp, bounces, sampling
+  int iterations = 0;       // fixed iteration count; 0 = Google Benchmark decides. Each
+                            // iteration rebuilds the BVH (untimed), so big scenes want few.
 };
 
 std::string render_benchmark_name(const RenderCase& c);
