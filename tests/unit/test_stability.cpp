@@ -37,12 +37,18 @@ Rendered render(const Scene& scene, RenderSettings s) {
   return r;
 }
 
-RenderSettings small_settings() {
+// A square image with light sampling: the settings every test here starts from.
+RenderSettings nee_settings(uint32_t size, uint32_t spp, int bounces) {
   RenderSettings s;
-  s.width = s.height = 64;
-  s.spp = 64;
-  s.max_bounces = 2;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.max_bounces = bounces;
   s.sampling = Sampling::Nee;
+  return s;
+}
+
+RenderSettings small_settings() {
+  RenderSettings s = nee_settings(64, 64, 2);
   s.variance = true;
   s.seed = 7;
   return s;
@@ -193,12 +199,8 @@ class Extremes : public ::testing::TestWithParam<Extreme> {};
 
 TEST_P(Extremes, FurnaceMeanStaysRight) {
   const Extreme x = GetParam();
-  RenderSettings s;
-  s.width = s.height = x.size;
-  s.spp = x.spp;
-  s.max_bounces = x.bounces;
+  RenderSettings s = nee_settings(x.size, x.spp, x.bounces);
   s.russian_roulette = x.roulette;
-  s.sampling = Sampling::Nee;
   s.variance = true;
   const Rendered r = render(make_furnace(x.albedo, x.emission), s);
   const double expected = x.bounces < 0 ? x.emission / (1.0 - x.albedo) : furnace_expected(x.albedo, x.emission, x.bounces);
@@ -228,12 +230,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 // A 8192 x 8192 image (67 M pixels, a 1.9 GB film) renders and every pixel gets its sample.
 TEST(ExtremesSlow, Image8192Squared) {
-  RenderSettings s;
-  s.width = s.height = 8192;
-  s.spp = 1;
-  s.max_bounces = 0;
-  s.sampling = Sampling::Nee;
-  const Rendered r = render(make_furnace(0.5f, 1.0f), s);
+  const Rendered r = render(make_furnace(0.5f, 1.0f), nee_settings(8192, 1, 0));
   EXPECT_EQ(r.report.paths, uint64_t(8192) * 8192);
   EXPECT_EQ(r.report.discarded_samples, 0u);
   for (uint32_t c : r.film.counts()) ASSERT_EQ(c, 1u);
@@ -257,12 +254,7 @@ TEST(NonFinite, FilmRefusesNaNAndInfAndCountsNothing) {
 // Emission so large that radiance overflows float: every sample is Inf, none may reach
 // the film, and the report counts them all.
 TEST(NonFinite, OverflowingRadianceIsDiscardedAndCounted) {
-  RenderSettings s;
-  s.width = s.height = 4;
-  s.spp = 4;
-  s.max_bounces = 2;
-  s.sampling = Sampling::Nee;
-  const Rendered r = render(make_furnace(0.9f, 3e38f), s);
+  const Rendered r = render(make_furnace(0.9f, 3e38f), nee_settings(4, 4, 2));
   EXPECT_EQ(r.report.discarded_samples, r.report.paths);
   for (float v : r.film.mean()) EXPECT_TRUE(std::isfinite(v));
 }
