@@ -21,28 +21,27 @@ Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, 
   PathState<float> st;
   path_begin(job.scene, job.config, pixel, sample, st);
   ShadowQuery<float> q;
-  auto occlusion_test = [&](uint64_t& counter) {
+  auto occlusion_test = [&](uint64_t RayCounts::*kind) {
     RTCRay sr;
     to_embree(q.ray, 1.0f, sr);
     rtcOccluded1(job.embree.handle(), &ctx, &sr);
-    ++counter;
+    count_ray(local.rays, st.depth, kind);
     if (sr.tfar >= 0.0f) shadow_unoccluded(st, q);
   };
   for (;;) {
-    uint64_t& ray_kind = st.depth == 0 ? local.rays.camera : local.rays.bounce;
     if (path_at_final_vertex(job.scene, job.config, st)) {  // only emitted light can still count
-      if (path_final_query(job.scene, job.config, st, q)) occlusion_test(st.depth == 0 ? ray_kind : local.rays.shadow);
+      if (path_final_query(job.scene, job.config, st, q)) occlusion_test(&RayCounts::shadow);
       break;
     }
     RTCRayHit rh;
     to_embree(st.ray, kInfinity, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(job.embree.handle(), &ctx, &rh);
-    ++ray_kind;
+    count_ray(local.rays, st.depth, &RayCounts::bounce);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
     bool wants_shadow;
     const PathEvent ev = path_hit(job.scene, job.config, st, surface_hit(job.scene, rh.hit.primID, st.ray), q, wants_shadow);
-    if (wants_shadow) occlusion_test(local.rays.shadow);
+    if (wants_shadow) occlusion_test(&RayCounts::shadow);
     if (ev == PathEvent::Done) break;
   }
   return st.L;

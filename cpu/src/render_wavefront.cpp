@@ -98,7 +98,7 @@ void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
     }
     if (path_final_query(job.scene, job.config, st, pool.shadow[slot])) {
       pool.shadowed.push_back(slot);
-      ++(st.depth == 0 ? local.rays.camera : local.rays.shadow);
+      count_ray(local.rays, st.depth, &RayCounts::shadow);
     }
     pool.done.push_back(slot);
   }
@@ -106,7 +106,7 @@ void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
 }
 
 void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local) {
-  for (uint32_t slot : pool.live) ++(pool.state[slot].depth == 0 ? local.rays.camera : local.rays.bounce);
+  for (uint32_t slot : pool.live) count_ray(local.rays, pool.state[slot].depth, &RayCounts::bounce);
   alignas(64) RTCRayHitNt<kPacket> packet;
   alignas(64) int valid[kPacket];
   for (size_t base = 0; base < pool.live.size(); base += kPacket) {
@@ -134,15 +134,17 @@ void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
     bool wants_shadow;
     const PathEvent ev =
         path_hit(job.scene, job.config, st, surface_hit(job.scene, pool.prim[slot], st.ray), pool.shadow[slot], wants_shadow);
-    if (wants_shadow) pool.shadowed.push_back(slot);
+    if (wants_shadow) {
+      pool.shadowed.push_back(slot);
+      ++local.rays.shadow;
+    }
     if (ev == PathEvent::Continue) pool.next_live.push_back(slot);
     else pool.done.push_back(slot);
   }
   std::swap(pool.live, pool.next_live);
 }
 
-// `finals`: how many of the shadowed paths are final-vertex queries (counted there).
-void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local, size_t finals) {
+void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx) {
   alignas(64) RTCRayNt<kPacket> packet;
   alignas(64) int valid[kPacket];
   for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
@@ -157,7 +159,6 @@ void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx
       if (packet.tfar[i] >= 0.0f) shadow_unoccluded(pool.state[slot], pool.shadow[slot]);
     }
   }
-  local.rays.shadow += pool.shadowed.size() - finals;
   pool.shadowed.clear();
 }
 
@@ -189,10 +190,9 @@ TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
       stage_generate(job, source, pool);
       if (pool.live.empty()) break;
       stage_final_vertex(job, pool, local);
-      const size_t finals = pool.shadowed.size();
       stage_intersect(job, pool, ctx, local);
       stage_shade(job, pool, local);
-      stage_shadow(job, pool, ctx, local, finals);
+      stage_shadow(job, pool, ctx);
       stage_accumulate(job, pool, local);
     }
   }, tbb::static_partitioner());

@@ -31,6 +31,13 @@ struct TraceTotals {
   uint64_t pool_bytes = 0;
 };
 
+// Rays are counted where they are traced. A path's first ray is its camera ray whatever
+// answers it (a closest-hit query, or at 0 bounces the last-vertex occlusion test);
+// later rays count as `otherwise` (bounce or shadow).
+inline void count_ray(RayCounts& rays, uint32_t depth, uint64_t RayCounts::*otherwise) {
+  ++(depth == 0 ? rays.camera : rays.*otherwise);
+}
+
 // One thread per image tile; each pixel sample traced alone (rtcIntersect1/rtcOccluded1).
 TraceTotals render_pixel_parallel(const TraceJob& job);
 // Bounded pool of paths per thread; each stage runs over the whole pool, rays go to
