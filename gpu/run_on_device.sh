@@ -81,7 +81,7 @@ if has bench; then
   log "paper-cornell 256x256x800, 2 bounces, nee"
   for i in 1 2 3 4 5; do render paper-pixel-$i $paper --strategy pixel; done
   for i in 1 2 3; do render paper-wavefront-$i $paper --strategy wavefront; done
-  for pif in 337920 675840 2703360; do render paper-wavefront-pif$pif $paper --strategy wavefront --paths-in-flight $pif; done
+  for pif in 135168 270336 675840 2703360; do render paper-wavefront-pif$pif $paper --strategy wavefront --paths-in-flight $pif; done
   render paper-paperqueue $paper --strategy paper-queue
   log "profiles"
   timeout 60 $PB render --device gpu --quiet $paper --strategy pixel --profile | tee -a "$OUT/summary.txt"

@@ -62,15 +62,32 @@ __global__ void k_probe() {}
 // warp taking 32 consecutive samples), the whole path in registers. Samples of one
 // pixel are summed in the warp (exact integer sums) before one atomic per pixel.
 
+// The last-vertex shortcut of path.h (path_final_query: the emitters tested one by one
+// plus one occlusion ray, instead of a closest-hit query) on the GPU: used after a
+// bounce only, so a path's first ray is always traced by the closest-hit kernel (the
+// wavefront's generate stage then stays a plain writer of camera rays). At depth 0 (a
+// 0-bounce render) both GPU strategies take the closest hit instead: the same value.
+__device__ __forceinline__ bool gpu_final_vertex(const SceneView& s, const PathConfig& c, const PathState<float>& st) {
+  return st.depth > 0 && path_at_final_vertex(s, c, st);
+}
+
 __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
                                             uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
   PathState<float> st;
   path_begin(s, c, pixel, sample, st);
+  ShadowQuery<float> q;
   for (;;) {
+    if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
+      if (path_final_query(s, c, st, q)) {
+        ++n_shadow;
+        if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
+      }
+      break;
+    }
+    if (st.depth > 0) ++n_bounce;  // the camera ray is counted per path
     float t;
     const uint32_t prim = intersect_closest(bvh, st.ray.o, st.ray.d, kInf, t);
     if (prim == kNoHit) break;
-    ShadowQuery<float> q;
     bool wants_shadow;
     const PathEvent ev = path_hit(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
     if (wants_shadow) {
@@ -78,7 +95,6 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
       if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
     }
     if (ev == PathEvent::Done) break;
-    ++n_bounce;
   }
   return st.L;
 }
@@ -203,17 +219,20 @@ struct PathSoA {
   float4* o;        // ray origin, bsdf_pdf
   float4* d;        // ray direction, pixel (bits)
   float4* beta;     // throughput, depth (bits)
-  float4* L;        // radiance so far (w unused)
-  uint32_t* sample;
+  float4* L;        // radiance so far, sample (bits)
 };
 
-// Shadow rays of one iteration. `target`: index of the continuing path in the next
-// buffer, or kShadowDone | pixel for a path that ended (its radiance is in L).
+// Shadow rays of one iteration: a light-sampling ray, or the last vertex's emitter
+// query (path_final_query), or both from the same origin (a "pair"). `target`: index
+// of the continuing path in the next buffer, or kShadowDone | pixel for a path that
+// ended (its radiance is in L; L.w != 0 marks a pair, whose second ray is d2/c2).
 struct ShadowSoA {
   float4* o;        // origin, contribution.x
   float4* d;        // direction (unnormalised, to the light point), contribution.y
   float2* ct;       // contribution.z, target (bits)
-  float4* L;        // radiance of a finished path (written and read only for those)
+  float4* L;        // radiance of a finished path, pair flag (written and read only for those)
+  float4* d2;       // a pair's second ray: direction, contribution.x
+  float2* c2;       // contribution.y, .z
 };
 constexpr uint32_t kShadowDone = 0x80000000u;  // pixels < 2^31 (RenderSettings::validate)
 
@@ -251,7 +270,7 @@ __device__ __forceinline__ PathState<float> load_path(const PathSoA& p, uint32_t
   st.beta = {b.x, b.y, b.z};
   st.depth = __float_as_uint(b.w);
   st.L = {L.x, L.y, L.z};
-  st.sample = p.sample[i];
+  st.sample = __float_as_uint(L.w);
   return st;
 }
 
@@ -259,8 +278,7 @@ __device__ __forceinline__ void store_path(const PathSoA& p, uint32_t i, const P
   p.o[i] = make_float4(st.ray.o.x, st.ray.o.y, st.ray.o.z, st.bsdf_pdf);
   p.d[i] = make_float4(st.ray.d.x, st.ray.d.y, st.ray.d.z, __uint_as_float(st.pixel));
   p.beta[i] = make_float4(st.beta.x, st.beta.y, st.beta.z, __uint_as_float(st.depth));
-  p.L[i] = make_float4(st.L.x, st.L.y, st.L.z, 0.0f);
-  p.sample[i] = st.sample;
+  p.L[i] = make_float4(st.L.x, st.L.y, st.L.z, __uint_as_float(st.sample));
 }
 
 // One thread: books the last iteration and plans this one's refill.
@@ -306,14 +324,20 @@ __global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cu
   }
 }
 
+__device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, const ShadowQuery<float>& q, uint32_t target) {
+  sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
+  sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
+  sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
+}
+
 template <bool kVariance>
-__global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
+__global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film) {
   const uint32_t n = ctr->n_cur;
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
     const uint32_t i = base + lane;
-    bool add = false;
+    bool add = false, pair = false;
     uint32_t pixel = 0;
     Vec3f L_add{0.0f, 0.0f, 0.0f};
     if (i < n) {
@@ -324,21 +348,33 @@ __global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, 
         add = true;
         L_add = st.L;
       } else {
-        ShadowQuery<float> q;
+        ShadowQuery<float> q, fq;
         bool wants_shadow;
-        const PathEvent ev = path_hit(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+        PathEvent ev = path_hit(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+        // The next vertex would be the last: answer it here (trace_path does the same
+        // at the top of its loop), so the path never goes through intersect + shade again.
+        bool final_ray = false;
+        if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
+          final_ray = path_final_query(s, c, st, fq);
+          ev = PathEvent::Done;
+        }
         uint32_t target = kShadowDone | st.pixel;
         if (ev == PathEvent::Continue) {
           const uint32_t j = queue_push(&ctr->n_next);
           store_path(next, j, st);
           target = j;
         }
-        if (wants_shadow) {
+        if (wants_shadow || final_ray) {
+          // Light-sampling ray first (shadow_unoccluded's order in trace_path); both
+          // rays of a pair leave from the same origin (the offset hit point).
           const uint32_t k = queue_push(&ctr->n_shadow);
-          sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
-          sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
-          sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
-          if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, 0.0f);
+          push_shadow(sh, k, wants_shadow ? q : fq, target);
+          pair = wants_shadow && final_ray;
+          if (pair) {
+            sh.d2[k] = make_float4(fq.ray.d.x, fq.ray.d.y, fq.ray.d.z, fq.contribution.x);
+            sh.c2[k] = make_float2(fq.contribution.y, fq.contribution.z);
+          }
+          if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, pair ? 1.0f : 0.0f);
         } else if (ev == PathEvent::Done) {
           add = true;
           L_add = st.L;
@@ -346,6 +382,8 @@ __global__ void __launch_bounds__(256, 4) k_wf_shade(SceneView s, PathConfig c, 
       }
     }
     film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
+    const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
+    if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
   }
 }
 
@@ -363,11 +401,17 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
       const float4 o = sh.o[i], d = sh.d[i];
       const float2 ct = sh.ct[i];
       const uint32_t target = __float_as_uint(ct.y);
-      const bool visible = !occluded(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, 1.0f);
+      const Vec3f origin{o.x, o.y, o.z};
+      const bool visible = !occluded(bvh, origin, {d.x, d.y, d.z}, 1.0f);
       if (target & kShadowDone) {
         const float4 l = sh.L[i];
         L = {l.x, l.y, l.z};
         if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
+        if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
+          const float4 d2 = sh.d2[i];
+          const float2 c2 = sh.c2[i];
+          if (!occluded(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
+        }
         add = true;
         pixel = target & ~kShadowDone;
       } else if (visible) {
@@ -589,17 +633,35 @@ struct FrameResult {
   uint64_t iterations = 0;
 };
 
+// Which shadow records a frame needs: light-sampling rays, the last vertex's emitter
+// queries (bounded paths, few emitters: path_at_final_vertex), and pairs of both.
+struct ShadowUse {
+  bool records = false;
+  bool pairs = false;
+  static ShadowUse of(const Scene& scene, const RenderSettings& settings) {
+    const bool lights = !scene.emitters.empty();
+    const bool nee = lights && settings.sampling == Sampling::Nee;
+    const bool final_queries = lights && settings.max_bounces > 0 && scene.emitters.size() <= kMaxEmittersForFinalQuery;
+    return {nee || final_queries, nee && final_queries};
+  }
+};
+
 // Path pool shared by wavefront and paper-queue.
 class PathPool {
  public:
-  PathPool(uint64_t capacity, bool shadows, const char* what, const char* lower) : capacity_(capacity), shadows_(shadows) {
+  PathPool(uint64_t capacity, ShadowUse shadows, const char* what, const char* lower)
+      : capacity_(capacity), shadows_(shadows) {
     for (auto& b : buf_) b.allocate(capacity, what, lower);
     prim_.allocate(capacity, what, lower);
-    if (shadows) {
+    if (shadows.records) {
       sh_o_.allocate(capacity, what, lower);
       sh_d_.allocate(capacity, what, lower);
       sh_ct_.allocate(capacity, what, lower);
       sh_L_.allocate(capacity, what, lower);
+    }
+    if (shadows.pairs) {
+      sh_d2_.allocate(capacity, what, lower);
+      sh_c2_.allocate(capacity, what, lower);
     }
     ctr_.allocate(1, what, lower);
     PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(WaveCounters)));
@@ -608,16 +670,18 @@ class PathPool {
   PathPool(const PathPool&) = delete;
   PathPool& operator=(const PathPool&) = delete;
 
-  // Per path: two state buffers (current and next), the hit, and with light sampling
-  // one shadow ray.
-  static uint64_t state_bytes(bool shadows) {
-    return 2 * Buffers::bytes_per_path() + sizeof(uint32_t) + (shadows ? 3 * sizeof(float4) + sizeof(float2) : 0);
+  // Per path: two state buffers (current and next), the hit, and where the settings
+  // trace shadow rays one shadow record (a second ray's 24 bytes where pairs occur).
+  static uint64_t state_bytes(ShadowUse shadows) {
+    return 2 * Buffers::bytes_per_path() + sizeof(uint32_t) +
+           (shadows.records ? 3 * sizeof(float4) + sizeof(float2) : 0) +
+           (shadows.pairs ? sizeof(float4) + sizeof(float2) : 0);
   }
 
   FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                   uint64_t total, FilmDev film, bool variance) {
     PB_CUDA_CHECK(cudaMemsetAsync(ctr_.get(), 0, sizeof(WaveCounters), stream));
-    const ShadowSoA sh{sh_o_.get(), sh_d_.get(), sh_ct_.get(), sh_L_.get()};
+    const ShadowSoA sh{sh_o_.get(), sh_d_.get(), sh_ct_.get(), sh_L_.get(), sh_d2_.get(), sh_c2_.get()};
     WaveCounters* ctr = ctr_.get();
     const uint32_t cap = uint32_t(capacity_);
     FrameResult r;
@@ -629,7 +693,7 @@ class PathPool {
       launch.launch("intersect", k_wf_intersect, 0, g.bvh, cur, prim_.get(), ctr);
       if (variance) launch.launch("shade", k_wf_shade<true>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
       else launch.launch("shade", k_wf_shade<false>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
-      if (shadows_) {
+      if (shadows_.records) {
         if (variance) launch.launch("shadow", k_wf_shadow<true>, 0, g.bvh, sh, next, ctr, film);
         else launch.launch("shadow", k_wf_shadow<false>, 0, g.bvh, sh, next, ctr, film);
       }
@@ -655,23 +719,21 @@ class PathPool {
  private:
   struct Buffers {
     DeviceBuffer<float4> o, d, beta, L;
-    DeviceBuffer<uint32_t> sample;
     void allocate(uint64_t n, const char* what, const char* lower) {
       o.allocate(n, what, lower);
       d.allocate(n, what, lower);
       beta.allocate(n, what, lower);
       L.allocate(n, what, lower);
-      sample.allocate(n, what, lower);
     }
-    PathSoA view() const { return {o.get(), d.get(), beta.get(), L.get(), sample.get()}; }
-    static uint64_t bytes_per_path() { return 4 * sizeof(float4) + sizeof(uint32_t); }
+    PathSoA view() const { return {o.get(), d.get(), beta.get(), L.get()}; }
+    static uint64_t bytes_per_path() { return 4 * sizeof(float4); }
   };
   uint64_t capacity_;
-  bool shadows_;
+  ShadowUse shadows_;
   Buffers buf_[2];
   DeviceBuffer<uint32_t> prim_;
-  DeviceBuffer<float4> sh_o_, sh_d_, sh_L_;
-  DeviceBuffer<float2> sh_ct_;
+  DeviceBuffer<float4> sh_o_, sh_d_, sh_L_, sh_d2_;
+  DeviceBuffer<float2> sh_ct_, sh_c2_;
   DeviceBuffer<WaveCounters> ctr_;
   WaveCounters* host_ctr_ = nullptr;
 };
@@ -722,7 +784,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   const PathConfig config = settings.path_config();
   const uint32_t pixels = settings.width * settings.height;
   const uint64_t total = settings.total_samples();
-  const bool shadows = settings.sampling == Sampling::Nee && !scene.emitters.empty();
+  const ShadowUse shadows = ShadowUse::of(scene, settings);
   film.begin(settings.spp, scene.max_emission());
 
   ScopedStream stream;
@@ -828,8 +890,9 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;
   x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
   if (settings.strategy != Strategy::Pixel) {
-    x["state_layout"] = shadows ? "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32 + shadow (o, d: float4; c.z+target: float2; L of a finished path: float4)"
-                                : "2 x (o+pdf, d+pixel, beta+depth, L: float4; sample: u32) + hit u32";
+    x["state_layout"] = std::string("2 x (o+pdf, d+pixel, beta+depth, L+sample: float4) + hit u32") +
+                        (shadows.records ? " + shadow record (o, d: float4; c.z+target: float2; L of a finished path: float4)" : "") +
+                        (shadows.pairs ? " + a pair's second ray (d: float4; c.yz: float2)" : "");
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
   }
