@@ -19,8 +19,11 @@ void cuda_fail(cudaError_t e, const char* what, const char* file, int line) {
 }
 
 DeviceMemory& DeviceMemory::instance() {
-  static DeviceMemory m;
-  return m;
+  // Never destroyed: buffers held by other statics (the benchmark's scene cache) are
+  // released during static destruction, in an order no one controls; a destroyed
+  // ledger there was a crash at exit (pathbench-bench, signal 11).
+  static DeviceMemory* m = new DeviceMemory;
+  return *m;
 }
 
 uint64_t DeviceMemory::free_bytes() {

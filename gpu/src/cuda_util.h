@@ -87,7 +87,8 @@ template <class T> class DeviceBuffer {
   uint64_t n_ = 0;
 };
 
-// The launch wrapper. Each kernel's block size comes from the occupancy calculator
+// The launch wrapper. Every kernel launched through it must begin with pdl_wait()
+// (kernel_sync.h). Each kernel's block size comes from the occupancy calculator
 // (cached); launches are counted per stage name and, when profiling, bracketed by CUDA
 // events whose times are summed per name after the frame.
 class Launcher {
@@ -112,8 +113,23 @@ class Launcher {
       ev[1] = next_event();
       PB_CUDA_CHECK(cudaEventRecord(ev[0], stream_));
     }
-    kernel<<<unsigned(grid), unsigned(st.block), 0, stream_>>>(std::forward<Args>(args)...);
-    const cudaError_t e = cudaGetLastError();
+    // Programmatic dependent launch (Hopper): the next kernel in the stream may be
+    // placed on the GPU while this one drains, and waits in pdl_wait() (kernel_sync.h)
+    // until this one has finished and its writes are visible. Hides the launch gap
+    // between the wavefront's many short dependent stages. Off while profiling, so each
+    // stage's events bracket only its own work.
+    cudaLaunchAttribute attr[1];
+    attr[0].id = cudaLaunchAttributeProgrammaticStreamSerialization;
+    attr[0].val.programmaticStreamSerializationAllowed = 1;
+    cudaLaunchConfig_t cfg{};
+    cfg.gridDim = dim3(unsigned(grid));
+    cfg.blockDim = dim3(unsigned(st.block));
+    cfg.dynamicSmemBytes = 0;
+    cfg.stream = stream_;
+    cfg.attrs = attr;
+    cfg.numAttrs = profile_ ? 0 : 1;
+    cudaError_t e = cudaLaunchKernelEx(&cfg, kernel, std::forward<Args>(args)...);
+    if (e == cudaSuccess) e = cudaGetLastError();
     if (e != cudaSuccess) cuda_fail(e, name, __FILE__, __LINE__);
     ++st.launches;
     if (profile_) {

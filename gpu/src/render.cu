@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "cuda_util.h"
+#include "kernel_sync.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "pathbench/gpu/bvh.h"
@@ -190,6 +191,7 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
 template <bool kVariance>
 __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
+  kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
   const uint64_t warp = (uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
   const uint64_t warps = (uint64_t(gridDim.x) * blockDim.x) >> 5;
@@ -283,6 +285,7 @@ __device__ __forceinline__ void store_path(const PathSoA& p, uint32_t i, const P
 
 // One thread: books the last iteration and plans this one's refill.
 __global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint32_t capacity) {
+  kernel_prologue();
   if (grid_thread() != 0) return;
   WaveCounters& c = *ctr;
   const uint32_t cont = c.n_next;  // paths that continued from the last shade
@@ -305,6 +308,7 @@ __global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint3
 // New samples after the continuing paths; a warp takes consecutive samples of a pixel,
 // as the pixel strategy does (coherent camera rays).
 __global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const WaveCounters* ctr, uint32_t spp) {
+  kernel_prologue();
   const uint32_t n = ctr->gen_count, dst = ctr->gen_dst;
   const unsigned long long base = ctr->gen_base;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
@@ -316,6 +320,7 @@ __global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig 
 }
 
 __global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+  kernel_prologue();
   const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const float4 o = cur.o[i], d = cur.d[i];
@@ -333,6 +338,7 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
 template <bool kVariance>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film) {
+  kernel_prologue();
   const uint32_t n = ctr->n_cur;
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
@@ -390,6 +396,7 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
 template <bool kVariance>
 __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
                                                       FilmDev film) {
+  kernel_prologue();
   const uint32_t n = ctr->n_shadow;
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
@@ -429,6 +436,7 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
 // ---------------------------------------------------------------------------------
 // Traversal for tests.
 __global__ void k_trace(BvhView bvh, const TraceQuery* rays, TraceResult* out, uint32_t n, bool any_hit) {
+  kernel_prologue();
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const TraceQuery r = rays[i];
     float t = r.t_max;
