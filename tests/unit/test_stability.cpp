@@ -1,10 +1,15 @@
-// Numerical stability at the extremes (CPU tracer): scene scale and offset, seams
-// where walls meet, watertight edges, extreme emission/albedo/bounces/image sizes,
-// long accumulation, and NaN/Inf never reaching the film.
+// Numerical stability at the extremes: scene scale and offset, seams where walls
+// meet, watertight edges, extreme emission/albedo/bounces/image sizes, long
+// accumulation, and NaN/Inf never reaching the film.
+// One source, two devices: built into the CPU unit tests, and with
+// PB_STABILITY_ON_GPU into tests/gpu's pathbench_gpu_stability_tests (label gpu), where
+// every render runs both GPU strategies, checks their films are identical, and all
+// tests report SKIPPED without a GPU.
 #include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -12,9 +17,26 @@
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/render.h"
 #include "stat_test.h"
+#ifdef PB_STABILITY_ON_GPU
+#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/render.h"
+#endif
 
 namespace pb {
 namespace {
+
+// At the top of every test: on the GPU build, SKIPPED (with the reason) without a GPU.
+#ifdef PB_STABILITY_ON_GPU
+#define PB_REQUIRE_DEVICE()                                    \
+  do {                                                         \
+    std::string why;                                           \
+    if (!gpu::device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
+  } while (0)
+#else
+#define PB_REQUIRE_DEVICE() \
+  do {                      \
+  } while (0)
+#endif
 
 // The scene with every point p moved to p * scale + offset (the camera too), then
 // finalized again so ray offsets follow the new extent.
@@ -33,7 +55,22 @@ struct Rendered {
 Rendered render(const Scene& scene, RenderSettings s) {
   s.progress = false;
   Rendered r{Film(s.width, s.height, s.variance), {}};
+#ifdef PB_STABILITY_ON_GPU
+  s.strategy = Strategy::Pixel;
+  gpu::render(scene, s, r.film, r.report, false);
+  // The wavefront must agree bit for bit, extremes included (it has queues to overflow
+  // and counters to wrap that the megakernel has not).
+  RenderSettings w = s;
+  w.strategy = Strategy::Wavefront;
+  Film wf(s.width, s.height, s.variance);
+  RunReport wr;
+  gpu::render(scene, w, wf, wr, false);
+  EXPECT_TRUE(wf.raw_sums() == r.film.raw_sums()) << "GPU wavefront film differs from pixel's";
+  EXPECT_TRUE(wf.counts() == r.film.counts()) << "GPU wavefront sample counts differ from pixel's";
+  EXPECT_EQ(wr.discarded_samples, r.report.discarded_samples);
+#else
   cpu::render(scene, s, r.film, r.report);
+#endif
   return r;
 }
 
@@ -67,6 +104,7 @@ class ScaleAndOffset : public ::testing::TestWithParam<Placement> {};
 // Radiance does not depend on units, so a scaled or moved copy of the scene gives the
 // same image up to noise: no light leaks through corners, no acne on walls.
 TEST_P(ScaleAndOffset, SameImageWithinNoise) {
+  PB_REQUIRE_DEVICE();
   const Scene original = make_paper_cornell();
   const Placement pl = GetParam();
   const Scene moved = transformed(original, pl.scale, pl.offset);
@@ -100,6 +138,7 @@ INSTANTIATE_TEST_SUITE_P(PaperCornell, ScaleAndOffset,
 // edges (Mitsuba's reference shows them too). Every wall-wall and wall-floor junction
 // below is tested.
 TEST(Seams, NoPixelIsADarkValleyBeyondNoise) {
+  PB_REQUIRE_DEVICE();
   RenderSettings s = small_settings();
   s.width = s.height = 128;
   s.spp = 128;
@@ -138,10 +177,14 @@ TEST(Seams, NoPixelIsADarkValleyBeyondNoise) {
 // Rays from inside a closed mesh aimed exactly at its shared edges and vertices must
 // hit it: none may slip between two triangles (that would end the path: a black seam).
 TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
+  PB_REQUIRE_DEVICE();
   for (const Scene& scene : {make_paper_cornell(), transformed(make_paper_cornell(), 1e3f, {1e4f, 0, 0})}) {
     const cpu::EmbreeScene embree(scene, /*watertight=*/true);  // as the CPU tracer builds it by default
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
+#ifdef PB_STABILITY_ON_GPU
+    std::vector<gpu::TraceQuery> queries;
+#endif
 
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -164,10 +207,19 @@ TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
       rh.ray.tfar = std::numeric_limits<float>::infinity();
       rh.ray.mask = ~0u;
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+#ifdef PB_STABILITY_ON_GPU
+      queries.push_back({o, d, std::numeric_limits<float>::infinity()});
+      ++rays;
+#else
       rtcIntersect1(embree.handle(), &ctx, &rh);
       ++rays;
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) ++misses;
+#endif
     }
+#ifdef PB_STABILITY_ON_GPU
+    for (const gpu::TraceResult& t : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
+      if (t.prim == gpu::kNoHit) ++misses;
+#endif
     EXPECT_EQ(misses, 0) << scene.name << ": " << misses << " of " << rays << " rays slipped through an edge";
   }
 }
@@ -198,6 +250,7 @@ struct Extreme {
 class Extremes : public ::testing::TestWithParam<Extreme> {};
 
 TEST_P(Extremes, FurnaceMeanStaysRight) {
+  PB_REQUIRE_DEVICE();
   const Extreme x = GetParam();
   RenderSettings s = nee_settings(x.size, x.spp, x.bounces);
   s.russian_roulette = x.roulette;
@@ -230,6 +283,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 // A 8192 x 8192 image (67 M pixels, a 1.9 GB film) renders and every pixel gets its sample.
 TEST(ExtremesSlow, Image8192Squared) {
+  PB_REQUIRE_DEVICE();
   const Rendered r = render(make_furnace(0.5f, 1.0f), nee_settings(8192, 1, 0));
   EXPECT_EQ(r.report.paths, uint64_t(8192) * 8192);
   EXPECT_EQ(r.report.discarded_samples, 0u);
@@ -240,6 +294,7 @@ TEST(ExtremesSlow, Image8192Squared) {
 // ---- NaN and Inf --------------------------------------------------------------------
 
 TEST(NonFinite, FilmRefusesNaNAndInfAndCountsNothing) {
+  PB_REQUIRE_DEVICE();
   Film f(2, 1, true);
   f.begin(4, 1.0f);
   EXPECT_FALSE(f.add(0, {std::numeric_limits<float>::quiet_NaN(), 0, 0}));
@@ -254,6 +309,7 @@ TEST(NonFinite, FilmRefusesNaNAndInfAndCountsNothing) {
 // Emission so large that radiance overflows float: every sample is Inf, none may reach
 // the film, and the report counts them all.
 TEST(NonFinite, OverflowingRadianceIsDiscardedAndCounted) {
+  PB_REQUIRE_DEVICE();
   const Rendered r = render(make_furnace(0.9f, 3e38f), nee_settings(4, 4, 2));
   EXPECT_EQ(r.report.discarded_samples, r.report.paths);
   for (float v : r.film.mean()) EXPECT_TRUE(std::isfinite(v));
