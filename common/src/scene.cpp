@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/features.h"
 
 namespace pb {
 
@@ -12,6 +13,16 @@ namespace {
 bool finite(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool non_negative(Vec3f v) { return v.x >= 0 && v.y >= 0 && v.z >= 0; }
 }  // namespace
+
+const char* to_string(MaterialKind k) {
+  switch (k) {
+    case MaterialKind::Diffuse: return "diffuse";
+    case MaterialKind::Mirror: return "mirror";
+    case MaterialKind::Dielectric: return "dielectric";
+    case MaterialKind::RoughConductor: return "roughconductor";
+  }
+  return "unknown";
+}
 
 void Scene::finalize() {
   if (triangles.empty()) throw InputError(fmt::format("{}: the scene has no triangles", name));
@@ -31,6 +42,13 @@ void Scene::finalize() {
       throw InputError(fmt::format("{}: material '{}' has an albedo above 1 (it would create energy)", name, mname));
     if (!finite(m.emission) || !non_negative(m.emission))
       throw InputError(fmt::format("{}: material '{}' has an emission that is negative, NaN or infinite", name, mname));
+    if (uint32_t(m.kind) >= kMaterialKindCount)
+      throw InputError(fmt::format("{}: material '{}' has an unknown kind {}", name, mname, uint32_t(m.kind)));
+    if (m.kind == MaterialKind::Dielectric && !(m.ior > 0 && std::isfinite(m.ior)))
+      throw InputError(fmt::format("{}: material '{}': ior {} must be a finite number above 0", name, mname, m.ior));
+    if (m.kind == MaterialKind::RoughConductor && !(m.alpha >= Material::kMinAlpha && m.alpha <= 1))
+      throw InputError(fmt::format("{}: material '{}': alpha {} is out of range ({} to 1; use a mirror for a smooth one)",
+                                   name, mname, m.alpha, Material::kMinAlpha));
   }
   if (!finite(camera.position) || !finite(camera.forward) || !finite(camera.up) || !finite(camera.right) ||
       !(camera.tan_half_fov_y > 0) || !std::isfinite(camera.tan_half_fov_y))
@@ -105,12 +123,19 @@ void Scene::finalize() {
   if (!emitter_cdf.empty()) emitter_cdf.back() = 1.0f;
   emitter_power_total = float(total);
   features.has_emitters = !emitters.empty();
+  if (const uint32_t missing = features.material_kinds & ~kCompiledMaterialKinds) {
+    std::string kinds;
+    for (uint32_t k = 0; k < kMaterialKindCount; ++k)
+      if (missing & (1u << k)) kinds += (kinds.empty() ? "" : ", ") + std::string(to_string(MaterialKind(k)));
+    throw InputError(fmt::format("{}: uses material kind(s) {}, but this build has only diffuse materials "
+                                 "(configured with -DPATHBENCH_EXTRA_MATERIALS=OFF)", name, kinds));
+  }
 }
 
 SceneView Scene::view() const {
   return {positions.data(), triangles.data(),  material_ids.data(),        materials.data(),
           emitters.data(),  emitter_cdf.data(), uint32_t(triangles.size()), uint32_t(emitters.size()),
-          emitter_power_total, camera,          offset};
+          emitter_power_total, camera,          offset,   features.material_kinds};
 }
 
 float Scene::max_emission() const {

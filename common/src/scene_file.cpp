@@ -247,13 +247,7 @@ class JsonSceneReader {
     const Json& materials = member(root, "materials", "");
     if (!materials.is_object() || materials.empty())
       fail("materials", "expected an object of named materials, e.g. {\"white\": {\"albedo\": [0.5, 0.5, 0.5]}}");
-    for (const auto& [name, m] : materials.items()) {
-      const std::string field = "materials." + name;
-      allow_keys(object(m, field), field, {"albedo", "emission"});
-      const Vec3f albedo = m.contains("albedo") ? vec3(m["albedo"], field + ".albedo") : Vec3f{0, 0, 0};
-      const Vec3f emission = m.contains("emission") ? vec3(m["emission"], field + ".emission") : Vec3f{0, 0, 0};
-      scenes::add_material(s, name, albedo, emission);
-    }
+    for (const auto& [name, m] : materials.items()) scenes::append_material(s, name, read_material(m, "materials." + name));
     if (root.contains("meshes")) {
       const Json& meshes = array(root["meshes"], "meshes");
       for (size_t i = 0; i < meshes.size(); ++i) read_mesh(s, meshes[i], fmt::format("meshes[{}]", i));
@@ -327,6 +321,47 @@ class JsonSceneReader {
     std::string known;
     for (const std::string& n : s.material_names) known += (known.empty() ? "" : ", ") + n;
     fail(field, fmt::format("unknown material '{}' (the file defines: {})", name, known));
+  }
+
+  // {"kind": K, "albedo": [r, g, b], "emission": [r, g, b], "ior": x, "alpha": x}: kind
+  // "diffuse" (the default), "mirror", "dielectric" or "roughconductor"; "ior" only for
+  // a dielectric, "alpha" only for a rough conductor. The albedo defaults to black for
+  // a diffuse material (an emitter, say) and to white for the others.
+  Material read_material(const Json& m, const std::string& field) const {
+    object(m, field);
+    Material mat;
+    if (m.contains("kind")) {
+      const std::string kind = string(m["kind"], field + ".kind");
+      uint32_t k = 0;
+      while (k < kMaterialKindCount && kind != to_string(MaterialKind(k))) ++k;
+      if (k == kMaterialKindCount)
+        fail(field + ".kind", fmt::format("unknown material kind '{}' (expected one of: diffuse, mirror, dielectric, "
+                                          "roughconductor)", kind));
+      mat.kind = MaterialKind(k);
+    }
+    if (m.contains("ior") && mat.kind != MaterialKind::Dielectric)
+      fail(field + ".ior", "applies only to materials of kind \"dielectric\"");
+    if (m.contains("alpha") && mat.kind != MaterialKind::RoughConductor)
+      fail(field + ".alpha", "applies only to materials of kind \"roughconductor\"");
+    switch (mat.kind) {
+      case MaterialKind::Dielectric: allow_keys(m, field, {"kind", "albedo", "emission", "ior"}); break;
+      case MaterialKind::RoughConductor: allow_keys(m, field, {"kind", "albedo", "emission", "alpha"}); break;
+      default: allow_keys(m, field, {"kind", "albedo", "emission"}); break;
+    }
+    const Vec3f default_albedo = mat.kind == MaterialKind::Diffuse ? Vec3f{0, 0, 0} : Vec3f{1, 1, 1};
+    mat.albedo = m.contains("albedo") ? vec3(m["albedo"], field + ".albedo") : default_albedo;
+    mat.emission = m.contains("emission") ? vec3(m["emission"], field + ".emission") : Vec3f{0, 0, 0};
+    if (m.contains("ior")) {
+      mat.ior = number(m["ior"], field + ".ior");
+      if (!(mat.ior > 0)) fail(field + ".ior", fmt::format("{} is not an index of refraction (must be above 0)", mat.ior));
+    }
+    if (m.contains("alpha")) {
+      mat.alpha = number(m["alpha"], field + ".alpha");
+      if (!(mat.alpha >= Material::kMinAlpha && mat.alpha <= 1))
+        fail(field + ".alpha", fmt::format("roughness {} is out of range ({} to 1; use \"mirror\" for a smooth one)",
+                                           mat.alpha, Material::kMinAlpha));
+    }
+    return mat;
   }
 
   void read_camera(Scene& s, const Json& cam) const {

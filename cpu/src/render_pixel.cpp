@@ -16,7 +16,9 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-// One complete path, single rays: the reference order of operations.
+// One complete path, single rays: the reference order of operations, compiled for the
+// material kinds `Kinds` (features.h).
+template <uint32_t Kinds>
 Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
   PathState<float> st;
   path_begin(job.scene, job.config, pixel, sample, st);
@@ -30,7 +32,7 @@ Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, 
   };
   for (;;) {
     if (path_at_final_vertex(job.scene, job.config, st)) {  // only emitted light can still count
-      if (path_final_query(job.scene, job.config, st, q)) occlusion_test(&RayCounts::shadow);
+      if (path_final_query<Kinds>(job.scene, job.config, st, q)) occlusion_test(&RayCounts::shadow);
       break;
     }
     RTCRayHit rh;
@@ -40,15 +42,14 @@ Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, 
     count_ray(local.rays, st.depth, &RayCounts::bounce);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
     bool wants_shadow;
-    const PathEvent ev = path_hit(job.scene, job.config, st, surface_hit(job.scene, rh.hit.primID, st.ray), q, wants_shadow);
+    const PathEvent ev = path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, rh.hit.primID, st.ray), q, wants_shadow);
     if (wants_shadow) occlusion_test(&RayCounts::shadow);
     if (ev == PathEvent::Done) break;
   }
   return st.L;
 }
-}  // namespace
 
-TraceTotals render_pixel_parallel(const TraceJob& job) {
+template <uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job) {
   const uint32_t w = job.config.width, h = job.config.height;
   tbb::combinable<Local> locals;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
@@ -59,7 +60,7 @@ TraceTotals render_pixel_parallel(const TraceJob& job) {
       for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
         const uint32_t pixel = y * w + x;
         for (uint32_t s = 0; s < job.spp; ++s) {
-          Vec3f L = trace_path(job, ctx, pixel, s, local);
+          Vec3f L = trace_path<Kinds>(job, ctx, pixel, s, local);
           ++local.paths;
           if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here
         }
@@ -75,6 +76,12 @@ TraceTotals render_pixel_parallel(const TraceJob& job) {
   t.state_bytes_per_path = sizeof(PathState<float>) + sizeof(ShadowQuery<float>);
   t.paths_in_flight = 0;  // one per thread, in registers and stack
   return t;
+}
+}  // namespace
+
+TraceTotals render_pixel_parallel(const TraceJob& job) {
+  return with_features(job.scene.material_kinds,
+                       [&](auto kinds) { return render_pixel_parallel_for<decltype(kinds)::value>(job); });
 }
 
 }  // namespace pb::cpu

@@ -88,6 +88,7 @@ void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool) {
 
 // Paths whose next hit could only add emitted light leave the live list here: their
 // occlusion test (if they face an emitter) joins the shadow stage, and they are done.
+template <uint32_t Kinds>
 void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
   size_t keep = 0;
   for (uint32_t slot : pool.live) {
@@ -96,7 +97,7 @@ void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
       pool.live[keep++] = slot;
       continue;
     }
-    if (path_final_query(job.scene, job.config, st, pool.shadow[slot])) {
+    if (path_final_query<Kinds>(job.scene, job.config, st, pool.shadow[slot])) {
       pool.shadowed.push_back(slot);
       count_ray(local.rays, st.depth, &RayCounts::shadow);
     }
@@ -123,6 +124,7 @@ void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& 
   }
 }
 
+template <uint32_t Kinds>
 void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
   pool.next_live.clear();
   for (uint32_t slot : pool.live) {
@@ -133,7 +135,7 @@ void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
     }
     bool wants_shadow;
     const PathEvent ev =
-        path_hit(job.scene, job.config, st, surface_hit(job.scene, pool.prim[slot], st.ray), pool.shadow[slot], wants_shadow);
+        path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, pool.prim[slot], st.ray), pool.shadow[slot], wants_shadow);
     if (wants_shadow) {
       pool.shadowed.push_back(slot);
       ++local.rays.shadow;
@@ -173,9 +175,8 @@ void stage_accumulate(const TraceJob& job, PoolSlice& pool, Local& local) {
   pool.done.clear();
 }
 
-}  // namespace
-
-TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
+// The stages above, compiled for the material kinds `Kinds` (features.h).
+template <uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight) {
   const uint32_t pixels = job.config.width * job.config.height;
   SampleSource source(uint64_t(pixels) * job.spp, pixels);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
@@ -189,9 +190,9 @@ TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
     for (;;) {
       stage_generate(job, source, pool);
       if (pool.live.empty()) break;
-      stage_final_vertex(job, pool, local);
+      stage_final_vertex<Kinds>(job, pool, local);
       stage_intersect(job, pool, ctx, local);
-      stage_shade(job, pool, local);
+      stage_shade<Kinds>(job, pool, local);
       stage_shadow(job, pool, ctx);
       stage_accumulate(job, pool, local);
     }
@@ -206,6 +207,13 @@ TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   t.paths_in_flight = per_slice * uint64_t(slices);
   t.pool_bytes = t.paths_in_flight * PoolSlice::bytes_per_path;
   return t;
+}
+
+}  // namespace
+
+TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
+  return with_features(job.scene.material_kinds,
+                       [&](auto kinds) { return render_wavefront_for<decltype(kinds)::value>(job, paths_in_flight); });
 }
 
 }  // namespace pb::cpu

@@ -96,7 +96,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"ScalingTooFew", "scaling:5", {"scaling:5", "out of range", "10 to 10000000"}},
         BadScene{"ScalingTooMany", "scaling:2e7", {"out of range"}},
         BadScene{"ScalingNotANumber", "scaling:many", {"'many' is not a number"}},
-        BadScene{"ParameterToAFixedScene", "cornell-box:2", {"cornell-box", "takes no parameters"}}),
+        BadScene{"ParameterToAFixedScene", "paper-cornell:2", {"paper-cornell", "takes no parameters"}},
+        BadScene{"CornellBoxUnknownVariant", "cornell-box:2", {"cornell-box:2", "unknown variant", "mirror, glass"}},
+        BadScene{"CornellBoxEmptyVariant", "cornell-box:", {"give a variant"}}),
     [](const auto& info) { return std::string(info.param.test); });
 
 // Scenes built in code: finalize() checks what the loaders cannot express.

@@ -8,11 +8,16 @@
 
 namespace pb::scenes {
 
-// Appends a diffuse material and returns its index.
-inline uint32_t add_material(Scene& s, std::string name, Vec3f albedo, Vec3f emission = {0, 0, 0}) {
-  s.materials.push_back({albedo, emission});
+// Appends a material of any kind and returns its index.
+inline uint32_t append_material(Scene& s, std::string name, const Material& m) {
+  s.materials.push_back(m);
   s.material_names.push_back(std::move(name));
   return uint32_t(s.materials.size() - 1);
+}
+
+// Appends a diffuse material and returns its index.
+inline uint32_t add_material(Scene& s, std::string name, Vec3f albedo, Vec3f emission = {0, 0, 0}) {
+  return append_material(s, std::move(name), Material{albedo, emission});
 }
 
 inline uint32_t add_vertex(Scene& s, Vec3f p) {

@@ -58,6 +58,8 @@ const std::vector<BuiltinSceneInfo>& builtin_scenes() {
       {"paper-cornell", "the 2015 paper's 14-triangle Cornell box (../shared/paper-scene.md)"},
       {"furnace:A,LE", "white furnace: closed cube, every wall albedo A (default 0.5), emission LE (default 1)"},
       {"cornell-box", "the Cornell box from Cornell University's published measurements (38 triangles)"},
+      {"cornell-box:V", "the Cornell box with V = mirror (tall block), glass (short block), spheres (mirror + glass, "
+                        "no blocks) or ggx (tall block rough metal)"},
       {"paper-cornell-ico:L", "paper-cornell plus an icosphere of level L = 0..10 (20*4^L triangles; L=8: 1,310,720)"},
       {"scaling:N", "paper-cornell plus a tessellated sphere: about N triangles in all (N = 10..10^7)"},
   };
@@ -75,10 +77,14 @@ Scene load_scene(const std::string& spec) {
   const size_t colon = spec.find(':');
   const std::string base = spec.substr(0, colon);
   const std::string params = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  if ((base == "paper-cornell" || base == "cornell-box") && colon != std::string::npos)
+  if (base == "paper-cornell" && colon != std::string::npos)
     throw InputError(fmt::format("scene '{}': '{}' takes no parameters", spec, base));
   if (base == "paper-cornell") return make_paper_cornell();
-  if (base == "cornell-box") return make_cornell_box();
+  if (base == "cornell-box") {
+    if (colon != std::string::npos && params.empty())
+      throw InputError(fmt::format("scene '{}': give a variant after the colon (mirror, glass, spheres, ggx)", spec));
+    return make_cornell_box(params);
+  }
   if (base == "paper-cornell-ico") return make_paper_cornell_ico(int(integer_param(spec, base, params, "level", 0, 10)));
   if (base == "scaling") return make_scaling(uint64_t(integer_param(spec, base, params, "triangle count", 10, 10000000)));
   if (base == "furnace") {

@@ -10,9 +10,15 @@
 // and one occlusion test (below).
 // Everything random comes from the (seed, pixel, sample, bounce) stream, so the order
 // in which a tracer runs these steps across paths cannot change the image.
+//
+// path_hit and path_final_query take the material kinds they are compiled for as a
+// leading template argument (features.h: a tracer dispatches once per render with
+// with_features); the default, every kind this build has, is right for any scene.
 #include <cstdint>
 
+#include "pathbench/common/bsdf/bsdf.h"
 #include "pathbench/common/camera.h"
+#include "pathbench/common/features.h"
 #include "pathbench/common/ray_offset.h"
 #include "pathbench/common/rng.h"
 #include "pathbench/common/sampling.h"
@@ -27,10 +33,11 @@ template <class T> struct PathState {
   Ray<T> ray;
   Vec3<T> beta;      // path throughput
   Vec3<T> L;         // radiance gathered so far
-  T bsdf_pdf;        // solid-angle pdf with which ray.d was sampled (for MIS)
+  T bsdf_pdf;        // solid-angle pdf with which ray.d was sampled (for MIS); 0 after a
+                     // delta bounce (mirror, glass), which light sampling cannot reproduce
   uint32_t pixel;
   uint32_t sample;
-  uint32_t depth;    // diffuse bounces taken so far
+  uint32_t depth;    // scattering events so far (every bounce, delta ones included)
 };
 
 // A shadow ray from a shading point to a point on an emitter: the emitter is visible
@@ -80,18 +87,21 @@ PB_HD uint32_t pick_emitter(const SceneView& s, float& u) {
 
 // What the path gains from emission `Le` seen at hit `h` (front side, cosine cos_o):
 // beta Le, weighted by MIS against light sampling when that could have found it too.
-template <class T>
+// After a delta bounce (bsdf_pdf 0) light sampling could not have found it: weight 1.
+template <uint32_t Kinds, class T>
 PB_HD Vec3<T> emitted_radiance(const SceneView& s, const PathConfig& c, const PathState<T>& st, const SurfaceHit<T>& h,
                                Vec3f Le, T cos_o) {
   T w = T(1);
-  if (c.sampling == Sampling::Nee && st.depth > 0) {
+  bool mis = c.sampling == Sampling::Nee && st.depth > 0;
+  if constexpr ((Kinds & kDeltaKinds) != 0) mis = mis && st.bsdf_pdf > T(0);
+  if (mis) {
     T pdf_light = emitter_area_pdf<T>(s, Le) * h.t * h.t / cos_o;
     w = power_heuristic(st.bsdf_pdf, pdf_light);
   }
   return st.beta * Vec3<T>(Le) * w;
 }
 
-template <class T>
+template <uint32_t Kinds = kCompiledMaterialKinds, class T>
 PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& st, const SurfaceHit<T>& h,
                          ShadowQuery<T>& shadow, bool& wants_shadow) {
   wants_shadow = false;
@@ -100,21 +110,21 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
 
   // 1. Emission (one-sided), weighted against light sampling when that could have
   //    found this point too.
-  if (cos_o > T(0) && !is_zero(m.emission)) st.L += emitted_radiance(s, c, st, h, m.emission, cos_o);
+  if (cos_o > T(0) && !is_zero(m.emission)) st.L += emitted_radiance<Kinds>(s, c, st, h, m.emission, cos_o);
 
-  // 2. The bounce budget is spent, or the surface does not reflect.
+  // 2. The bounce budget is spent, or the surface does not scatter.
   if (c.max_bounces >= 0 && st.depth >= uint32_t(c.max_bounces)) return PathEvent::Done;
   if (is_zero(m.albedo)) return PathEvent::Done;
 
   const Vec3<T> n = cos_o >= T(0) ? h.ng : -h.ng;  // two-sided: face the incoming ray
-  const Vec3<T> f = Vec3<T>(m.albedo) * kInvPi<T>;
+  const Frame<T> frame = Frame<T>::from_normal(n);
   const uint32_t vertex = st.depth + 1;
   const RngStream rng{st.pixel, c.seed};
   const Uniform4 ub = rng.draw(st.sample, vertex, kRngVertex);
   const Vec3<T> origin = offset_ray_origin(h.p, n, s.offset);
 
-  // 3. Light sampling.
-  if (c.sampling == Sampling::Nee && s.num_emitters > 0) {
+  // 3. Light sampling, where the BSDF is not a delta.
+  if (c.sampling == Sampling::Nee && s.num_emitters > 0 && !bsdf_is_delta<Kinds>(m)) {
     float u_pick = ub.v[2];
     const uint32_t tri_id = s.emitters[pick_emitter(s, u_pick)];
     const Triangle tri = s.triangles[tri_id];
@@ -132,8 +142,9 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
     if (cos_s > T(0) && cos_l > T(0) && dist2 > T(0)) {
       const Vec3f Le = s.material_of(tri_id).emission;
       const T pdf_light = emitter_area_pdf<T>(s, Le) * dist2 / cos_l;
-      const T w = power_heuristic(pdf_light, cosine_hemisphere_pdf(cos_s));
-      shadow.contribution = st.beta * f * Vec3<T>(Le) * (cos_s * w / pdf_light);
+      const BsdfEval<T> f = bsdf_eval<Kinds>(m, frame, st.ray.d, wi, cos_s);
+      const T w = power_heuristic(pdf_light, f.pdf);
+      shadow.contribution = st.beta * f.f * Vec3<T>(Le) * (cos_s * w / pdf_light);
       const Vec3<T> target = offset_ray_origin(y, nl, s.offset);
       shadow.ray = {origin, target - origin};
       wants_shadow = true;
@@ -141,17 +152,9 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
   }
 
   // 4. Next direction from the BSDF.
-  Vec3<T> local;
-  T pdf;
-  if (c.sampling == Sampling::Uniform) {
-    local = sample_uniform_hemisphere(T(ub.v[0]), T(ub.v[1]));
-    pdf = uniform_hemisphere_pdf<T>();
-  } else {
-    local = sample_cosine_hemisphere(T(ub.v[0]), T(ub.v[1]));
-    pdf = cosine_hemisphere_pdf(local.z);
-  }
-  if (!(pdf > T(0)) || !(local.z > T(0))) return PathEvent::Done;  // grazing: no contribution
-  st.beta *= f * (local.z / pdf);
+  BsdfSample<T> bs;
+  if (!bsdf_sample<Kinds>(m, c.sampling, frame, st.ray.d, cos_o >= T(0), ub, bs)) return PathEvent::Done;
+  st.beta *= bs.weight;
 
   // 5. Russian roulette.
   if (c.russian_roulette && vertex >= c.rr_start_depth) {
@@ -160,8 +163,12 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
     st.beta = st.beta / q;
   }
 
-  st.ray = {origin, Frame<T>::from_normal(n).to_world(local)};
-  st.bsdf_pdf = pdf;
+  // A refracted ray leaves from the other side of the surface.
+  Vec3<T> next_origin = origin;
+  if constexpr (has_kind<Kinds>(MaterialKind::Dielectric))
+    if (dot(bs.wi, n) < T(0)) next_origin = offset_ray_origin(h.p, -n, s.offset);
+  st.ray = {next_origin, bs.wi};
+  st.bsdf_pdf = bs.pdf;
   st.depth = vertex;
   return PathEvent::Continue;
 }
@@ -182,7 +189,7 @@ PB_HD bool path_at_final_vertex(const SceneView& s, const PathConfig& c, const P
 
 // Returns true and fills `q` when an emitter facing the ray lies along it; the path is
 // done either way.
-template <class T>
+template <uint32_t Kinds = kCompiledMaterialKinds, class T>
 PB_HD bool path_final_query(const SceneView& s, const PathConfig& c, const PathState<T>& st, ShadowQuery<T>& q) {
   const WatertightRay wr = make_watertight_ray(Vec3f(st.ray.o), Vec3f(st.ray.d));
   float closest = 3.402823466e38f;
@@ -201,7 +208,7 @@ PB_HD bool path_final_query(const SceneView& s, const PathConfig& c, const PathS
   const T cos_o = -dot(h.ng, st.ray.d);
   const Vec3f Le = s.material_of(prim).emission;
   if (!(cos_o > T(0)) || is_zero(Le)) return false;
-  q.contribution = emitted_radiance(s, c, st, h, Le, cos_o);
+  q.contribution = emitted_radiance<Kinds>(s, c, st, h, Le, cos_o);
   q.ray = {st.ray.o, offset_ray_origin(h.p, h.ng, s.offset) - st.ray.o};  // up to just in front of it
   return true;
 }

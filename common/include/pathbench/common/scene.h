@@ -12,12 +12,24 @@
 
 namespace pb {
 
-enum class MaterialKind : uint32_t { Diffuse = 0 };
+// The BSDFs (one header each under bsdf/, named after Mitsuba 3's plugins they match).
+enum class MaterialKind : uint32_t {
+  Diffuse = 0,         // two-sided Lambertian (bsdf/lambert.h)
+  Mirror = 1,          // perfect mirror (bsdf/mirror.h)
+  Dielectric = 2,      // smooth glass (bsdf/dielectric.h)
+  RoughConductor = 3,  // GGX microfacet metal (bsdf/roughconductor.h)
+};
+constexpr uint32_t kMaterialKindCount = 4;
+const char* to_string(MaterialKind k);  // "diffuse", "mirror", "dielectric", "roughconductor"
 
 struct Material {
-  Vec3f albedo;    // two-sided Lambertian reflectance, f = albedo / pi
+  Vec3f albedo;    // diffuse: reflectance, f = albedo / pi; mirror and rough conductor:
+                   // specular reflectance; dielectric: tint of reflection and transmission
   Vec3f emission;  // one-sided emitted radiance on the side of the geometric normal
   MaterialKind kind = MaterialKind::Diffuse;
+  float ior = 1.5f;    // dielectric: interior index of refraction (exterior 1), > 0
+  float alpha = 0.1f;  // rough conductor: GGX roughness alpha, in [kMinAlpha, 1]
+  static constexpr float kMinAlpha = 1e-3f;  // below, float GGX is a mirror with NaNs
 };
 
 struct Triangle {
@@ -26,7 +38,7 @@ struct Triangle {
 
 // What a scene uses, so tracers carry and branch on nothing else.
 struct SceneFeatures {
-  uint32_t material_kinds = 0;  // bit i set: MaterialKind(i) present
+  uint32_t material_kinds = 0;  // bit i set: MaterialKind(i) present (features.h dispatches on it)
   bool has_emitters = false;
   float extent = 0;             // bounding-box diagonal, sets ray offsets
   bool uses(MaterialKind k) const { return material_kinds & (1u << uint32_t(k)); }
@@ -45,6 +57,7 @@ struct SceneView {
   float emitter_power_total;     // sum over emitters of area * mean(emission)
   Camera camera;
   RayOffset offset;
+  uint32_t material_kinds;       // SceneFeatures::material_kinds: picks the path step's instantiation
 
   PB_HD const Material& material_of(uint32_t tri) const { return materials[material_ids[tri]]; }
 };

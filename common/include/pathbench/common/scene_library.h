@@ -25,6 +25,10 @@ Scene make_furnace(float albedo, float emission);
 // The Cornell box from Cornell University's published data (millimetres; camera at
 // (278, 273, -800) looking along +z, 39.3 degree field of view).
 Scene make_cornell_box();
+// The same room with mirror, glass or rough-metal objects: `variant` is one of
+// cornell_box_variants() ("mirror", "glass", "spheres", "ggx"); "" is make_cornell_box().
+Scene make_cornell_box(const std::string& variant);
+const std::vector<std::string>& cornell_box_variants();
 // make_paper_cornell() plus an icosphere of subdivision `level` (0..10: 20 * 4^level
 // triangles), radius 5, centre (0, -4, -4), albedo 0.5.
 Scene make_paper_cornell_ico(int level);
