@@ -72,6 +72,7 @@ __device__ __forceinline__ bool gpu_final_vertex(const SceneView& s, const PathC
   return st.depth > 0 && path_at_final_vertex(s, c, st);
 }
 
+template <uint32_t Kinds>
 __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
                                             uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
   PathState<float> st;
@@ -79,7 +80,7 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
   ShadowQuery<float> q;
   for (;;) {
     if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
-      if (path_final_query(s, c, st, q)) {
+      if (path_final_query<Kinds>(s, c, st, q)) {
         ++n_shadow;
         if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
       }
@@ -90,7 +91,7 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
     const uint32_t prim = intersect_closest(bvh, st.ray.o, st.ray.d, kInf, t);
     if (prim == kNoHit) break;
     bool wants_shadow;
-    const PathEvent ev = path_hit(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
+    const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
     if (wants_shadow) {
       ++n_shadow;
       if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
@@ -188,7 +189,7 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
   }
 }
 
-template <bool kVariance>
+template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
   kernel_prologue();
@@ -202,7 +203,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
     const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
+      L = trace_path<Kinds>(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
@@ -335,7 +336,7 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
   sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
 }
 
-template <bool kVariance>
+template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film) {
   kernel_prologue();
@@ -356,12 +357,12 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
       } else {
         ShadowQuery<float> q, fq;
         bool wants_shadow;
-        PathEvent ev = path_hit(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+        PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
         // The next vertex would be the last: answer it here (trace_path does the same
         // at the top of its loop), so the path never goes through intersect + shade again.
         bool final_ray = false;
         if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
-          final_ray = path_final_query(s, c, st, fq);
+          final_ray = path_final_query<Kinds>(s, c, st, fq);
           ev = PathEvent::Done;
         }
         uint32_t target = kShadowDone | st.pixel;
@@ -699,8 +700,11 @@ class PathPool {
       launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
       launch.launch("generate", k_wf_generate, 0, g.view, c, cur, ctr, spp);
       launch.launch("intersect", k_wf_intersect, 0, g.bvh, cur, prim_.get(), ctr);
-      if (variance) launch.launch("shade", k_wf_shade<true>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
-      else launch.launch("shade", k_wf_shade<false>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+      with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
+        constexpr uint32_t K = decltype(kinds)::value;
+        if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+        else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+      });
       if (shadows_.records) {
         if (variance) launch.launch("shadow", k_wf_shadow<true>, 0, g.bvh, sh, next, ctr, film);
         else launch.launch("shadow", k_wf_shadow<false>, 0, g.bvh, sh, next, ctr, film);
@@ -749,8 +753,12 @@ class PathPool {
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                       uint64_t total, FilmDev film, bool variance, DeviceBuffer<Stats>& stats) {
   PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
-  if (variance) launch.launch("pixel", k_pixel<true>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
-  else launch.launch("pixel", k_pixel<false>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
+  // The megakernel compiled for the scene's material kinds (features.h).
+  with_features(g.view.material_kinds, [&](auto kinds) {
+    constexpr uint32_t K = decltype(kinds)::value;
+    if (variance) launch.launch("pixel", k_pixel<true, K>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
+    else launch.launch("pixel", k_pixel<false, K>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
+  });
   FrameResult r;
   PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, stats.get(), sizeof(Stats), cudaMemcpyDeviceToHost, stream));
   PB_CUDA_CHECK(cudaStreamSynchronize(stream));

@@ -103,7 +103,11 @@ INSTANTIATE_TEST_SUITE_P(Cases, GpuStrategies,
                                            StrategyCase{"paper-cornell", Sampling::Uniform, 2},
                                            StrategyCase{"paper-cornell", Sampling::Cosine, -1},
                                            StrategyCase{"cornell-box", Sampling::Nee, -1},
-                                           StrategyCase{"paper-cornell-ico:3", Sampling::Nee, 3}),
+                                           StrategyCase{"paper-cornell-ico:3", Sampling::Nee, 3},
+                                           // Materials beyond Lambertian (the shade kernel's other instantiation).
+                                           StrategyCase{"cornell-box:spheres", Sampling::Nee, -1},
+                                           StrategyCase{"cornell-box:ggx", Sampling::Nee, 4},
+                                           StrategyCase{"cornell-box:mirror", Sampling::Cosine, 3}),
                          [](const auto& info) {
                            std::string n = std::string(info.param.scene) + "_" + to_string(info.param.sampling) + "_" +
                                            (info.param.bounces < 0 ? std::string("rr") : std::to_string(info.param.bounces));
@@ -167,6 +171,14 @@ TEST(GpuVsCpu, PaperCornell) {
 TEST(GpuVsCpu, CornellBox) {
   PB_REQUIRE_GPU();
   gpu_vs_cpu("cornell-box");
+}
+TEST(GpuVsCpu, CornellBoxSpheres) {  // mirror + glass
+  PB_REQUIRE_GPU();
+  gpu_vs_cpu("cornell-box:spheres");
+}
+TEST(GpuVsCpu, CornellBoxGgx) {  // rough conductor
+  PB_REQUIRE_GPU();
+  gpu_vs_cpu("cornell-box:ggx");
 }
 
 // The traversal cross-check of tests/gpu/test_traversal.cpp, run on the device: the
