@@ -17,10 +17,10 @@ struct Local {
 };
 
 // One complete path, single rays: the reference order of operations.
-Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
-  PathState<float> st;
+template <class T> Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
+  PathState<T> st;
   path_begin(job.scene, job.config, pixel, sample, st);
-  ShadowQuery<float> q;
+  ShadowQuery<T> q;
   auto occlusion_test = [&](uint64_t RayCounts::*kind) {
     RTCRay sr;
     to_embree(q.ray, 1.0f, sr);
@@ -44,11 +44,11 @@ Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, 
     if (wants_shadow) occlusion_test(&RayCounts::shadow);
     if (ev == PathEvent::Done) break;
   }
-  return st.L;
+  return Vec3f(st.L);
 }
 }  // namespace
 
-TraceTotals render_pixel_parallel(const TraceJob& job) {
+template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
   const uint32_t w = job.config.width, h = job.config.height;
   tbb::combinable<Local> locals;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
@@ -59,7 +59,7 @@ TraceTotals render_pixel_parallel(const TraceJob& job) {
       for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
         const uint32_t pixel = y * w + x;
         for (uint32_t s = 0; s < job.spp; ++s) {
-          Vec3f L = trace_path(job, ctx, pixel, s, local);
+          Vec3f L = trace_path<T>(job, ctx, pixel, s, local);
           ++local.paths;
           if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here
         }
@@ -72,9 +72,12 @@ TraceTotals render_pixel_parallel(const TraceJob& job) {
     t.paths += l.paths;
     t.discarded += l.discarded;
   });
-  t.state_bytes_per_path = sizeof(PathState<float>) + sizeof(ShadowQuery<float>);
+  t.state_bytes_per_path = sizeof(PathState<T>) + sizeof(ShadowQuery<T>);
   t.paths_in_flight = 0;  // one per thread, in registers and stack
   return t;
 }
+
+template TraceTotals render_pixel_parallel<float>(const TraceJob&);
+template TraceTotals render_pixel_parallel<double>(const TraceJob&);
 
 }  // namespace pb::cpu
