@@ -223,6 +223,7 @@ int run_accuracy(AccuracyOptions& o) {
   out["reference"] = ref.info;
   out["reference"]["spp"] = o.reference_spp;
   out["reference"]["rel_mse_floor"] = floor;
+  out["reference"]["precision"] = ref.info["report"].value("precision", "double");
   out["reference"].erase("report");
   fmt::print(stderr, "accuracy: reference {} spp {} ({:.1f} s); its own relMSE floor {:.3g}\n", o.reference_spp,
              ref.info.value("cached", false) ? "from the cache" : "rendered",
