@@ -37,6 +37,16 @@ void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, R
 #endif
 }
 
+double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
+
+std::string machine_folder(Device device) {
+#if PATHBENCH_HAVE_CUDA
+  if (device == Device::Gpu) return gpu::device_info().slug;
+#endif
+  (void)device;
+  return machine_slug();
+}
+
 void write_text_file(const std::string& path, const std::string& text) {
   std::filesystem::path p(path);
   if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());

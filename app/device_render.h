@@ -16,6 +16,12 @@ void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, R
 // *why_not (if given) to the reason.
 bool gpu_available(std::string* why_not);
 
+// The render time to report: CUDA-event time on the GPU, host wall clock on the CPU.
+double render_seconds(const RunReport& r);
+// The results/<machine>/ folder name for runs on `device`: the CPU's slug, or the
+// GPU's (pb::gpu::DeviceInfo::slug) since the GPU sets a GPU run's numbers.
+std::string machine_folder(Device device);
+
 // Writes text to `path` through a temporary file and a rename.
 void write_text_file(const std::string& path, const std::string& text);
 

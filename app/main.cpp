@@ -4,6 +4,7 @@
 
 #include <exception>
 
+#include "accuracy_command.h"
 #include "bench_command.h"
 #include "compare_command.h"
 #include "pathbench/common/errors.h"
@@ -22,6 +23,10 @@ int main(int argc, char** argv) {
   pb::app::BenchOptions bench;
   auto* bench_cmd = app.add_subcommand("bench", "run the Google Benchmark harness (pathbench-bench) with a preset");
   pb::app::add_bench_options(*bench_cmd, bench);
+  pb::app::AccuracyOptions accuracy;
+  auto* accuracy_cmd = app.add_subcommand(
+      "accuracy", "measure the speed/accuracy trade: error against a converged reference, per configuration and spp");
+  pb::app::add_accuracy_options(*accuracy_cmd, accuracy);
   pb::app::CompareOptions compare;
   auto* compare_cmd = app.add_subcommand("compare", "judge two benchmark JSON files for regressions (Mann-Whitney U)");
   pb::app::add_compare_options(*compare_cmd, compare);
@@ -38,6 +43,7 @@ int main(int argc, char** argv) {
     if (render_cmd->parsed()) return pb::app::run_render(render);
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
     if (compare_cmd->parsed()) return pb::app::run_compare(compare);
+    if (accuracy_cmd->parsed()) return pb::app::run_accuracy(accuracy);
     if (bench_cmd->parsed()) return pb::app::run_bench(bench, bench_cmd->remaining());
   } catch (const pb::InputError& e) {
     fmt::print(stderr, "pathbench: error: {}\n", e.what());

@@ -20,6 +20,9 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--rr,!--no-rr", o.settings.russian_roulette, "Russian roulette (default: only with --converged)");
   cmd.add_flag("--watertight,!--no-watertight", o.settings.watertight,
                "watertight ray/triangle test (default on; off is faster on the CPU and can leak at edges)");
+  cmd.add_option("--precision", o.precision,
+                 "scalar type of the path step: float or double (the hit triangle is found in float either way)")
+      ->capture_default_str();
   cmd.add_option("--sampling", o.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
   cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
   cmd.add_option("--strategy", o.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
@@ -37,6 +40,7 @@ void finish_render_options(RenderOptions& o) {
   o.settings.sampling = parse_sampling(o.sampling);
   o.settings.strategy = parse_strategy(o.strategy);
   o.settings.device = parse_device(o.device);
+  o.settings.precision = parse_precision(o.precision);
   if (o.converged) {
     o.settings.max_bounces = -1;
     o.settings.russian_roulette = true;
@@ -67,10 +71,11 @@ int run_render(RenderOptions& o) {
   if (!o.variance_out.empty()) write_image(o.variance_out, film.variance_of_mean(), film.width(), film.height());
   if (!o.report.empty()) write_text_file(o.report, report.to_json().dump(2) + "\n");
   if (!o.quiet) {
-    fmt::print("{} {}x{} {} spp, {} bounces, {} sampling, {}/{}: {:.3f} s, {:.2f} M rays/s ({} rays, {} paths",
+    fmt::print("{} {}x{} {} spp, {} bounces, {} sampling, {}, {}/{}: {:.3f} s, {:.2f} M rays/s ({} rays, {} paths",
                scene.name, o.settings.width, o.settings.height, o.settings.spp,
                o.settings.max_bounces < 0 ? std::string("unbounded") : std::to_string(o.settings.max_bounces),
-               to_string(o.settings.sampling), to_string(o.settings.device), to_string(o.settings.strategy),
+               to_string(o.settings.sampling), to_string(o.settings.precision), to_string(o.settings.device),
+               to_string(o.settings.strategy),
                report.seconds, report.rays_per_second() / 1e6, report.rays.total(), report.paths);
     if (report.discarded_samples) fmt::print(", {} discarded", report.discarded_samples);
     fmt::print(")\n");

@@ -15,7 +15,7 @@ namespace pb::app {
 struct RenderOptions {
   std::string scene = "paper-cornell";
   RenderSettings settings;
-  std::string sampling = "nee", strategy = "pixel", device = "cpu";
+  std::string sampling = "nee", strategy = "pixel", device = "cpu", precision = "float";
   bool converged = false;
   std::string out, report, variance_out;
   bool profile = false;

@@ -29,8 +29,6 @@ std::string fmt_bytes(double b) {
   return fmt::format("{:.0f} kB", b / 1e3);
 }
 
-double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
-
 uint64_t queue_bytes(const RunReport& r) {
   for (const char* key : {"queue_bytes", "pool_bytes", "pool_device_bytes"})
     if (r.extra.contains(key) && r.extra[key].is_number()) return r.extra[key].get<uint64_t>();

@@ -26,6 +26,7 @@ nlohmann::json RunReport::to_json() const {
   j["russian_roulette"] = settings.russian_roulette;
   j["sampling"] = to_string(settings.sampling);
   j["watertight"] = settings.watertight;
+  j["precision"] = to_string(settings.precision);
   j["device"] = to_string(settings.device);
   j["strategy"] = to_string(settings.strategy);
   j["seed"] = settings.seed;

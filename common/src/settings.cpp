@@ -23,6 +23,7 @@ const char* to_string(Strategy s) {
   return "?";
 }
 const char* to_string(Device d) { return d == Device::Cpu ? "cpu" : "gpu"; }
+const char* to_string(Precision p) { return p == Precision::Float ? "float" : "double"; }
 
 Sampling parse_sampling(std::string_view s) {
   if (s == "uniform") return Sampling::Uniform;
@@ -40,6 +41,11 @@ Device parse_device(std::string_view s) {
   if (s == "cpu") return Device::Cpu;
   if (s == "gpu") return Device::Gpu;
   throw InputError(fmt::format("--device: unknown device '{}' (expected cpu or gpu)", s));
+}
+Precision parse_precision(std::string_view s) {
+  if (s == "float") return Precision::Float;
+  if (s == "double") return Precision::Double;
+  throw InputError(fmt::format("--precision: unknown precision '{}' (expected float or double)", s));
 }
 
 void RenderSettings::validate() const {

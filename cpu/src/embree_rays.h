@@ -8,9 +8,10 @@
 
 namespace pb::cpu {
 
-inline void to_embree(const Ray<float>& r, float tfar, RTCRay& e) {
-  e.org_x = r.o.x; e.org_y = r.o.y; e.org_z = r.o.z;
-  e.dir_x = r.d.x; e.dir_y = r.d.y; e.dir_z = r.d.z;
+// Embree traces in float: a double ray is rounded to float here.
+template <class T> inline void to_embree(const Ray<T>& r, float tfar, RTCRay& e) {
+  e.org_x = float(r.o.x); e.org_y = float(r.o.y); e.org_z = float(r.o.z);
+  e.dir_x = float(r.d.x); e.dir_y = float(r.d.y); e.dir_z = float(r.d.z);
   e.tnear = 0.0f;
   e.tfar = tfar;
   e.time = 0.0f;
@@ -19,9 +20,9 @@ inline void to_embree(const Ray<float>& r, float tfar, RTCRay& e) {
   e.flags = 0;
 }
 
-template <int N> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<float>& r, float tfar) {
-  p.org_x[i] = r.o.x; p.org_y[i] = r.o.y; p.org_z[i] = r.o.z;
-  p.dir_x[i] = r.d.x; p.dir_y[i] = r.d.y; p.dir_z[i] = r.d.z;
+template <int N, class T> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<T>& r, float tfar) {
+  p.org_x[i] = float(r.o.x); p.org_y[i] = float(r.o.y); p.org_z[i] = float(r.o.z);
+  p.dir_x[i] = float(r.d.x); p.dir_y[i] = float(r.d.y); p.dir_z[i] = float(r.d.z);
   p.tnear[i] = 0.0f;
   p.tfar[i] = tfar;
   p.time[i] = 0.0f;

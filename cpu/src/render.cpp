@@ -34,12 +34,13 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress};
 
   const auto t0 = std::chrono::steady_clock::now();
+  const uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads);
+  const bool dbl = settings.precision == Precision::Double;
   TraceTotals totals;
   if (settings.strategy == Strategy::Pixel) {
-    totals = render_pixel_parallel(job);
+    totals = dbl ? render_pixel_parallel<double>(job) : render_pixel_parallel<float>(job);
   } else {
-    uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads);
-    totals = render_wavefront(job, pif);
+    totals = dbl ? render_wavefront<double>(job, pif) : render_wavefront<float>(job, pif);
   }
   const auto t1 = std::chrono::steady_clock::now();
   progress.finish();

@@ -16,13 +16,13 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-// One complete path, single rays: the reference order of operations, compiled for the
-// material kinds `Kinds` (features.h).
-template <uint32_t Kinds>
+// One complete path, single rays: the reference order of operations, in scalar type T
+// and compiled for the material kinds `Kinds` (features.h).
+template <class T, uint32_t Kinds>
 Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
-  PathState<float> st;
+  PathState<T> st;
   path_begin(job.scene, job.config, pixel, sample, st);
-  ShadowQuery<float> q;
+  ShadowQuery<T> q;
   auto occlusion_test = [&](uint64_t RayCounts::*kind) {
     RTCRay sr;
     to_embree(q.ray, 1.0f, sr);
@@ -46,10 +46,10 @@ Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, 
     if (wants_shadow) occlusion_test(&RayCounts::shadow);
     if (ev == PathEvent::Done) break;
   }
-  return st.L;
+  return Vec3f(st.L);
 }
 
-template <uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job) {
+template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job) {
   const uint32_t w = job.config.width, h = job.config.height;
   tbb::combinable<Local> locals;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
@@ -60,7 +60,7 @@ template <uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& 
       for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
         const uint32_t pixel = y * w + x;
         for (uint32_t s = 0; s < job.spp; ++s) {
-          Vec3f L = trace_path<Kinds>(job, ctx, pixel, s, local);
+          Vec3f L = trace_path<T, Kinds>(job, ctx, pixel, s, local);
           ++local.paths;
           if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here
         }
@@ -73,15 +73,18 @@ template <uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& 
     t.paths += l.paths;
     t.discarded += l.discarded;
   });
-  t.state_bytes_per_path = sizeof(PathState<float>) + sizeof(ShadowQuery<float>);
+  t.state_bytes_per_path = sizeof(PathState<T>) + sizeof(ShadowQuery<T>);
   t.paths_in_flight = 0;  // one per thread, in registers and stack
   return t;
 }
 }  // namespace
 
-TraceTotals render_pixel_parallel(const TraceJob& job) {
+template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
   return with_features(job.scene.material_kinds,
-                       [&](auto kinds) { return render_pixel_parallel_for<decltype(kinds)::value>(job); });
+                       [&](auto kinds) { return render_pixel_parallel_for<T, decltype(kinds)::value>(job); });
 }
+
+template TraceTotals render_pixel_parallel<float>(const TraceJob&);
+template TraceTotals render_pixel_parallel<double>(const TraceJob&);
 
 }  // namespace pb::cpu

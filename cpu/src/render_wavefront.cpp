@@ -51,7 +51,7 @@ class SampleSource {
   uint32_t pixels_;
 };
 
-struct PoolSlice {
+template <class T> struct PoolSlice {
   explicit PoolSlice(size_t n) : state(n), shadow(n), prim(n) {
     free.reserve(n);
     live.reserve(n);
@@ -60,13 +60,13 @@ struct PoolSlice {
     done.reserve(n);
     for (size_t i = n; i-- > 0;) free.push_back(uint32_t(i));
   }
-  std::vector<PathState<float>> state;
-  std::vector<ShadowQuery<float>> shadow;
+  std::vector<PathState<T>> state;
+  std::vector<ShadowQuery<T>> shadow;
   std::vector<uint32_t> prim;  // hit triangle, or RTC_INVALID_GEOMETRY_ID
   std::vector<uint32_t> free, live, next_live, shadowed, done;
 
   static constexpr size_t bytes_per_path =
-      sizeof(PathState<float>) + sizeof(ShadowQuery<float>) + sizeof(uint32_t) * 6;
+      sizeof(PathState<T>) + sizeof(ShadowQuery<T>) + sizeof(uint32_t) * 6;
 };
 
 struct Local {
@@ -74,7 +74,7 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool) {
+template <class T> void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice<T>& pool) {
   uint64_t n = pool.free.size();
   if (n == 0) return;
   const uint64_t start = src.claim(n);
@@ -88,11 +88,11 @@ void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice& pool) {
 
 // Paths whose next hit could only add emitted light leave the live list here: their
 // occlusion test (if they face an emitter) joins the shadow stage, and they are done.
-template <uint32_t Kinds>
-void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
+template <class T, uint32_t Kinds>
+void stage_final_vertex(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
   size_t keep = 0;
   for (uint32_t slot : pool.live) {
-    const PathState<float>& st = pool.state[slot];
+    const PathState<T>& st = pool.state[slot];
     if (!path_at_final_vertex(job.scene, job.config, st)) {
       pool.live[keep++] = slot;
       continue;
@@ -106,7 +106,7 @@ void stage_final_vertex(const TraceJob& job, PoolSlice& pool, Local& local) {
   pool.live.resize(keep);
 }
 
-void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx, Local& local) {
+template <class T> void stage_intersect(const TraceJob& job, PoolSlice<T>& pool, RTCIntersectContext& ctx, Local& local) {
   for (uint32_t slot : pool.live) count_ray(local.rays, pool.state[slot].depth, &RayCounts::bounce);
   alignas(64) RTCRayHitNt<kPacket> packet;
   alignas(64) int valid[kPacket];
@@ -124,11 +124,11 @@ void stage_intersect(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& 
   }
 }
 
-template <uint32_t Kinds>
-void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
+template <class T, uint32_t Kinds>
+void stage_shade(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
   pool.next_live.clear();
   for (uint32_t slot : pool.live) {
-    PathState<float>& st = pool.state[slot];
+    PathState<T>& st = pool.state[slot];
     if (pool.prim[slot] == RTC_INVALID_GEOMETRY_ID) {
       pool.done.push_back(slot);
       continue;
@@ -146,7 +146,7 @@ void stage_shade(const TraceJob& job, PoolSlice& pool, Local& local) {
   std::swap(pool.live, pool.next_live);
 }
 
-void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx) {
+template <class T> void stage_shadow(const TraceJob& job, PoolSlice<T>& pool, RTCIntersectContext& ctx) {
   alignas(64) RTCRayNt<kPacket> packet;
   alignas(64) int valid[kPacket];
   for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
@@ -164,10 +164,10 @@ void stage_shadow(const TraceJob& job, PoolSlice& pool, RTCIntersectContext& ctx
   pool.shadowed.clear();
 }
 
-void stage_accumulate(const TraceJob& job, PoolSlice& pool, Local& local) {
+template <class T> void stage_accumulate(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
   for (uint32_t slot : pool.done) {
-    const PathState<float>& st = pool.state[slot];
-    if (!job.film.add_atomic(st.pixel, st.L)) ++local.discarded;
+    const PathState<T>& st = pool.state[slot];
+    if (!job.film.add_atomic(st.pixel, Vec3f(st.L))) ++local.discarded;
     pool.free.push_back(slot);
   }
   local.paths += pool.done.size();
@@ -175,8 +175,8 @@ void stage_accumulate(const TraceJob& job, PoolSlice& pool, Local& local) {
   pool.done.clear();
 }
 
-// The stages above, compiled for the material kinds `Kinds` (features.h).
-template <uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight) {
+// The stages above, in scalar type T, compiled for the material kinds `Kinds` (features.h).
+template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight) {
   const uint32_t pixels = job.config.width * job.config.height;
   SampleSource source(uint64_t(pixels) * job.spp, pixels);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
@@ -184,15 +184,15 @@ template <uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, 
   tbb::combinable<Local> locals;
   tbb::parallel_for(0, slices, [&](int) {
     Local& local = locals.local();
-    PoolSlice pool(per_slice);
+    PoolSlice<T> pool(per_slice);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
       stage_generate(job, source, pool);
       if (pool.live.empty()) break;
-      stage_final_vertex<Kinds>(job, pool, local);
+      stage_final_vertex<T, Kinds>(job, pool, local);
       stage_intersect(job, pool, ctx, local);
-      stage_shade<Kinds>(job, pool, local);
+      stage_shade<T, Kinds>(job, pool, local);
       stage_shadow(job, pool, ctx);
       stage_accumulate(job, pool, local);
     }
@@ -203,17 +203,20 @@ template <uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, 
     t.paths += l.paths;
     t.discarded += l.discarded;
   });
-  t.state_bytes_per_path = PoolSlice::bytes_per_path;
+  t.state_bytes_per_path = PoolSlice<T>::bytes_per_path;
   t.paths_in_flight = per_slice * uint64_t(slices);
-  t.pool_bytes = t.paths_in_flight * PoolSlice::bytes_per_path;
+  t.pool_bytes = t.paths_in_flight * PoolSlice<T>::bytes_per_path;
   return t;
 }
 
 }  // namespace
 
-TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
+template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   return with_features(job.scene.material_kinds,
-                       [&](auto kinds) { return render_wavefront_for<decltype(kinds)::value>(job, paths_in_flight); });
+                       [&](auto kinds) { return render_wavefront_for<T, decltype(kinds)::value>(job, paths_in_flight); });
 }
+
+template TraceTotals render_wavefront<float>(const TraceJob&, uint64_t);
+template TraceTotals render_wavefront<double>(const TraceJob&, uint64_t);
 
 }  // namespace pb::cpu

@@ -38,10 +38,13 @@ inline void count_ray(RayCounts& rays, uint32_t depth, uint64_t RayCounts::*othe
   ++(depth == 0 ? rays.camera : rays.*otherwise);
 }
 
+// Both strategies run the path step in the scalar type T (float or double, the
+// --precision setting; instantiated for both in their .cpp files). Embree finds the hit
+// triangle in float either way; surface_hit recomputes the hit in T.
 // One thread per image tile; each pixel sample traced alone (rtcIntersect1/rtcOccluded1).
-TraceTotals render_pixel_parallel(const TraceJob& job);
+template <class T> TraceTotals render_pixel_parallel(const TraceJob& job);
 // Bounded pool of paths per thread; each stage runs over the whole pool, rays go to
 // Embree in 16-wide packets; finished paths are replaced by new samples.
-TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight);
+template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight);
 
 }  // namespace pb::cpu

@@ -16,6 +16,10 @@ enum class Sampling : uint32_t {
 };
 enum class Strategy : uint32_t { Pixel = 0, Wavefront = 1, PaperQueue = 2 };
 enum class Device : uint32_t { Cpu = 0, Gpu = 1 };
+// Scalar type of the path step (camera ray, surface_hit, shading, sampling). The
+// intersector always finds the hit triangle in float (Embree); with Double the hit
+// point is then recomputed in double from the triangle id (surface_hit).
+enum class Precision : uint32_t { Float = 0, Double = 1 };
 
 struct PathConfig {
   int32_t max_bounces;        // diffuse reflections; -1 = unbounded (Russian roulette ends paths)
@@ -40,6 +44,7 @@ struct RenderSettings {
   int threads = 0;               // CPU threads; 0 = all
   bool variance = false;         // also accumulate per-pixel variance
   bool watertight = true;        // watertight ray/triangle test (CPU: Embree's robust mode)
+  Precision precision = Precision::Float;  // scalar type of the path step
   bool progress = true;
 
   PathConfig path_config() const {
@@ -53,8 +58,10 @@ struct RenderSettings {
 const char* to_string(Sampling s);
 const char* to_string(Strategy s);
 const char* to_string(Device d);
+const char* to_string(Precision p);
 Sampling parse_sampling(std::string_view s);  // throw InputError on unknown names
 Strategy parse_strategy(std::string_view s);
 Device parse_device(std::string_view s);
+Precision parse_precision(std::string_view s);
 
 }  // namespace pb

@@ -1,0 +1,103 @@
+#include "accuracy_reference.h"
+
+#include <fmt/core.h>
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+
+#include "device_render.h"
+#include "pathbench/common/errors.h"
+#include "pathbench/common/film.h"
+#include "pathbench/common/image_io.h"
+#include "pathbench/common/report.h"
+
+namespace pb::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+// A seed no sweep render uses, so the reference's noise is independent of theirs.
+constexpr uint64_t kReferenceSeed = 0x7265666572656e63ull;  // "referenc"
+
+std::string stem_of(const Scene& scene, const RenderSettings& s) {
+  return fmt::format("reference-{}-{}x{}-{}-{}spp-v{}", file_slug(scene.name), s.width, s.height, to_string(s.device),
+                     s.spp, kReferenceVersion);
+}
+
+bool try_load(const std::string& dir, const std::string& stem, const RenderSettings& s, Reference& ref) {
+  const fs::path json = fs::path(dir) / (stem + ".json");
+  if (!fs::exists(json) || !fs::exists(fs::path(dir) / (stem + ".pfm")) || !fs::exists(fs::path(dir) / (stem + "-var.pfm")))
+    return false;
+  std::ifstream in(json);
+  nlohmann::json info = nlohmann::json::parse(in, nullptr, false);
+  if (info.is_discarded() || info.value("version", -1) != kReferenceVersion) return false;
+  unsigned w = 0, h = 0, vw = 0, vh = 0;
+  ref.mean = read_image((fs::path(dir) / (stem + ".pfm")).string(), w, h);
+  ref.var = read_image((fs::path(dir) / (stem + "-var.pfm")).string(), vw, vh);
+  if (w != s.width || h != s.height || vw != w || vh != h) return false;
+  ref.info = info;
+  ref.info["cached"] = true;
+  return true;
+}
+}  // namespace
+
+std::string file_slug(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c))) out += char(std::tolower(static_cast<unsigned char>(c)));
+    else if (!out.empty() && out.back() != '-') out += '-';
+  }
+  while (!out.empty() && out.back() == '-') out.pop_back();
+  return out.empty() ? "scene" : out;
+}
+
+RenderSettings reference_settings(const RenderSettings& base, uint32_t spp) {
+  RenderSettings s = base;
+  s.spp = spp;
+  s.max_bounces = -1;
+  s.russian_roulette = true;
+  s.sampling = Sampling::Nee;
+  s.watertight = true;
+  s.precision = Precision::Double;
+  s.seed = kReferenceSeed;
+  s.variance = true;
+  return s;
+}
+
+Reference load_or_render_reference(const Scene& scene, const RenderSettings& base, uint32_t spp,
+                                   const std::string& dir, bool regenerate, bool progress) {
+  RenderSettings s = reference_settings(base, spp);
+  s.progress = progress;
+  const std::string stem = stem_of(scene, s);
+  Reference ref;
+  if (!regenerate && try_load(dir, stem, s, ref)) return ref;
+
+  Film film(s.width, s.height, true);
+  RunReport report;
+  try {
+    render_on_device(scene, s, film, report, false);
+  } catch (const InputError& e) {
+    if (s.device != Device::Gpu) throw;
+    // A GPU tracer without double precision: the best it has.
+    fmt::print(stderr, "accuracy: reference in double refused by the GPU ({}); rendering it in float\n", e.what());
+    s.precision = Precision::Float;
+    film = Film(s.width, s.height, true);
+    render_on_device(scene, s, film, report, false);
+  }
+  ref.mean = film.mean();
+  ref.var = film.variance_of_mean();
+  fs::create_directories(dir);
+  write_image((fs::path(dir) / (stem + ".pfm")).string(), ref.mean, s.width, s.height);
+  write_image((fs::path(dir) / (stem + "-var.pfm")).string(), ref.var, s.width, s.height);
+  ref.info = {{"version", kReferenceVersion},
+              {"file", stem + ".pfm"},
+              {"variance_file", stem + "-var.pfm"},
+              {"seconds", render_seconds(report)},
+              {"report", report.to_json()}};
+  write_text_file((fs::path(dir) / (stem + ".json")).string(), ref.info.dump(2) + "\n");
+  ref.info["cached"] = false;
+  return ref;
+}
+
+}  // namespace pb::app

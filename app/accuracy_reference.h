@@ -1,0 +1,38 @@
+#pragma once
+// The converged reference of `pathbench accuracy`: the best estimator the tracer has
+// (unbounded paths ended by Russian roulette, light sampling + MIS, watertight,
+// double precision where the device runs it) at many samples per pixel, with its
+// variance image. Rendered once and cached as PFM + JSON, keyed by scene, size,
+// device, spp and kReferenceVersion.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+
+namespace pb::app {
+
+// Bump when the estimator (common/path.h), the built-in scenes or the reference's
+// settings change, so that cached references are rendered again.
+inline constexpr int kReferenceVersion = 1;
+
+struct Reference {
+  std::vector<float> mean, var;  // RGB; var: variance of the per-pixel mean
+  nlohmann::json info;           // settings, seconds, file names, whether it came from the cache
+};
+
+// The reference's settings: `base` supplies size, device, strategy and threads.
+RenderSettings reference_settings(const RenderSettings& base, uint32_t spp);
+
+// A file-name-safe form of a scene name ("scenes/box.json" -> "scenes-box-json").
+std::string file_slug(const std::string& name);
+
+// Loads the cached reference from `dir`, or renders it there (also when
+// `regenerate`). `progress` shows the render's progress bar.
+Reference load_or_render_reference(const Scene& scene, const RenderSettings& base, uint32_t spp,
+                                   const std::string& dir, bool regenerate, bool progress);
+
+}  // namespace pb::app
