@@ -1,0 +1,37 @@
+#pragma once
+// A loaded scene as the Python module holds it: the finalized pb::Scene plus the
+// acceleration structures the ray casts need, built on first use and kept, so a
+// script casting many batches pays for each build once.
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "pathbench/common/scene.h"
+#include "pathbench/cpu/embree_scene.h"
+#include "pathbench/gpu/bvh_build.h"
+
+namespace pb::python {
+
+// The scene with every point p moved to p * scale + offset (the camera too), then
+// finalized again so bounds and ray offsets follow the new extent. Throws InputError
+// for a scale that is not finite and positive or an offset that is not finite.
+Scene transformed(Scene s, float scale, Vec3f offset);
+
+class SceneHandle {
+ public:
+  explicit SceneHandle(Scene scene) : scene_(std::move(scene)) {}
+  const Scene& scene() const { return scene_; }
+
+  // The CPU tracer's Embree scene (EmbreeScene(scene, watertight)), built once per flag.
+  const cpu::EmbreeScene& embree(bool watertight) const;
+  // The GPU tracer's BVH (build_bvh with its default options), kept on the host.
+  const gpu::BvhHost& bvh() const;
+
+ private:
+  Scene scene_;
+  mutable std::mutex mutex_;
+  mutable std::unique_ptr<cpu::EmbreeScene> embree_[2];  // [watertight]
+  mutable std::unique_ptr<gpu::BvhHost> bvh_;
+};
+
+}  // namespace pb::python
