@@ -68,37 +68,39 @@ __global__ void k_probe() {}
 // bounce only, so a path's first ray is always traced by the closest-hit kernel (the
 // wavefront's generate stage then stays a plain writer of camera rays). At depth 0 (a
 // 0-bounce render) both GPU strategies take the closest hit instead: the same value.
-__device__ __forceinline__ bool gpu_final_vertex(const SceneView& s, const PathConfig& c, const PathState<float>& st) {
+template <class T>
+__device__ __forceinline__ bool gpu_final_vertex(const SceneView& s, const PathConfig& c, const PathState<T>& st) {
   return st.depth > 0 && path_at_final_vertex(s, c, st);
 }
 
-template <uint32_t Kinds>
+// One path in registers, in scalar type T (the traversal finds the hit triangle in
+// float either way; surface_hit recomputes the hit in T), with the watertight or the
+// Moeller-Trumbore triangle test.
+template <uint32_t Kinds, class T, bool kWatertight>
 __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
                                             uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
-  PathState<float> st;
+  PathState<T> st;
   path_begin(s, c, pixel, sample, st);
-  ShadowQuery<float> q;
+  ShadowQuery<T> q;
+  auto occlusion_test = [&] {
+    ++n_shadow;
+    if (!occluded<kWatertight>(bvh, Vec3f(q.ray.o), Vec3f(q.ray.d), 1.0f)) shadow_unoccluded(st, q);
+  };
   for (;;) {
     if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
-      if (path_final_query<Kinds>(s, c, st, q)) {
-        ++n_shadow;
-        if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
-      }
+      if (path_final_query<Kinds>(s, c, st, q)) occlusion_test();
       break;
     }
     if (st.depth > 0) ++n_bounce;  // the camera ray is counted per path
     float t;
-    const uint32_t prim = intersect_closest(bvh, st.ray.o, st.ray.d, kInf, t);
+    const uint32_t prim = intersect_closest<kWatertight>(bvh, Vec3f(st.ray.o), Vec3f(st.ray.d), kInf, t);
     if (prim == kNoHit) break;
     bool wants_shadow;
     const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
-    if (wants_shadow) {
-      ++n_shadow;
-      if (!occluded(bvh, q.ray.o, q.ray.d, 1.0f)) shadow_unoccluded(st, q);
-    }
+    if (wants_shadow) occlusion_test();
     if (ev == PathEvent::Done) break;
   }
-  return st.L;
+  return Vec3f(st.L);
 }
 
 template <class T> __device__ __forceinline__ T shfl_down(T v, int off) { return __shfl_down_sync(kFullMask, v, off); }
@@ -189,7 +191,7 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
   }
 }
 
-template <bool kVariance, uint32_t Kinds>
+template <bool kVariance, uint32_t Kinds, class T, bool kWatertight>
 __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
   kernel_prologue();
@@ -203,7 +205,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
     const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path<Kinds>(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
+      L = trace_path<Kinds, T, kWatertight>(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
@@ -751,13 +753,18 @@ class PathPool {
 };
 
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
-                      uint64_t total, FilmDev film, bool variance, DeviceBuffer<Stats>& stats) {
+                      uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
+                      DeviceBuffer<Stats>& stats) {
   PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
+  // In float with the watertight test, or (the accuracy study's variants) in double or
+  // with Moeller-Trumbore.
   with_features(g.view.material_kinds, [&](auto kinds) {
     constexpr uint32_t K = decltype(kinds)::value;
-    if (variance) launch.launch("pixel", k_pixel<true, K>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
-    else launch.launch("pixel", k_pixel<false, K>, 0, g.view, g.bvh, c, spp, total, film, stats.get());
+    auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, stats.get()); };
+    if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true>) : go(k_pixel<false, K, double, true>);
+    else if (!watertight) variance ? go(k_pixel<true, K, float, false>) : go(k_pixel<false, K, float, false>);
+    else variance ? go(k_pixel<true, K, float, true>) : go(k_pixel<false, K, float, true>);
   });
   FrameResult r;
   PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, stats.get(), sizeof(Stats), cudaMemcpyDeviceToHost, stream));
@@ -808,6 +815,12 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   FilmBuffers fb;
   fb.allocate(film, pixels);
 
+  if (settings.strategy != Strategy::Pixel && settings.precision != Precision::Float)
+    throw InputError(fmt::format("--precision {}: the GPU runs double precision with --strategy pixel only (its "
+                                 "wavefront state is float4 arrays)", to_string(settings.precision)));
+  if (settings.strategy != Strategy::Pixel && !settings.watertight)
+    throw InputError("--no-watertight: the GPU runs the Moeller-Trumbore triangle test with --strategy pixel only");
+
   // Strategy resources.
   std::unique_ptr<PathPool> pool;
   DeviceBuffer<Stats> pixel_stats;
@@ -838,7 +851,8 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
 
   auto run_frame = [&](uint64_t n) {
     if (settings.strategy == Strategy::Pixel)
-      return run_pixel(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance(), pixel_stats);
+      return run_pixel(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance(), settings.precision,
+                       settings.watertight, pixel_stats);
     return pool->run(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance());
   };
 

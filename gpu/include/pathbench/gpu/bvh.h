@@ -8,6 +8,7 @@
 
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
+#include "pathbench/common/moller_trumbore.h"
 #include "pathbench/common/watertight.h"
 
 namespace pb::gpu {
@@ -111,8 +112,9 @@ PB_HD float safe_inverse(float d) {
 
 // Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
 // own direction (need not be unit length). Returns the scene triangle id, or kNoHit;
-// t_hit receives the distance of a hit.
-template <bool kAnyHit>
+// t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
+// Moeller-Trumbore (the paper's; the accuracy study's comparison).
+template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
   const WatertightRay wr = make_watertight_ray(o, d);
@@ -160,7 +162,10 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       detail::load_triangle(bvh.tris, i, a, b, c, prim);
       if (stats) ++stats->tris;
       float tt;
-      if (intersect_watertight(wr, a, b, c, t, tt)) {
+      bool h;
+      if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
+      else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
+      if (h) {
         t = tt;
         hit = prim;
         if (kAnyHit) { t_hit = t; return hit; }
@@ -173,12 +178,14 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
   return hit;
 }
 
+template <bool kWatertight = true>
 PB_HD uint32_t intersect_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
-  return traverse<false>(bvh, o, d, t_max, t_hit);
+  return traverse<false, kWatertight>(bvh, o, d, t_max, t_hit);
 }
+template <bool kWatertight = true>
 PB_HD bool occluded(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
   float t;
-  return traverse<true>(bvh, o, d, t_max, t) != kNoHit;
+  return traverse<true, kWatertight>(bvh, o, d, t_max, t) != kNoHit;
 }
 
 }  // namespace pb::gpu
