@@ -1,18 +1,18 @@
 #!/usr/bin/env bash
 # Builds, tests, sanitizes and benchmarks the GPU tracer on a GPU host (the device
 # machine), writing everything under $OUT (default: ./device-out). Phases are chosen
-# by arguments: build test sanitize bench ico (default: all).
+# by arguments: build test sanitize bench ico accuracy (default: all).
 #   source .gpu-deps/unpack.sh is done here; see ../shared/gpu-host/README.md.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 OUT=${OUT:-$PWD/device-out}
 mkdir -p "$OUT/logs" "$OUT/json"
 pack() {
-  tar czf "$OUT/device-results.tar.gz" -C "$OUT" logs json summary.txt 2>/dev/null
-  rm -rf "$OUT/logs" "$OUT/json"
+  tar czf "$OUT/device-results.tar.gz" -C "$OUT" logs json summary.txt $(cd "$OUT" && ls -d accuracy 2>/dev/null) 2>/dev/null
+  rm -rf "$OUT/logs" "$OUT/json" "$OUT/accuracy"
 }
 trap pack EXIT
-phases=${*:-build test sanitize bench ico}
+phases=${*:-build test sanitize bench ico accuracy}
 has() { [[ " $phases " == *" $1 "* ]]; }
 log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
 B=build-gpu
@@ -41,6 +41,9 @@ if has test; then
   (cd $B && ctest -L gpu --output-on-failure -V --timeout 300) > "$OUT/logs/ctest-gpu.txt" 2>&1
   log "ctest -L gpu rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-gpu.txt)"
   grep -E "INFO|FAILED|Failure" "$OUT/logs/ctest-gpu.txt" | sed 's/^[0-9]*: //' | sort -u | tee -a "$OUT/summary.txt"
+  log "stability suite on the GPU (gpu.* tests)"
+  grep -E "^ *[0-9]+/[0-9]+ Test +#[0-9]+: gpu\." "$OUT/logs/ctest-gpu.txt" | sed 's/^ *[0-9]*\/[0-9]* //' > "$OUT/logs/stability-gpu.txt"
+  echo "$(grep -c Passed "$OUT/logs/stability-gpu.txt") passed, $(grep -vc Passed "$OUT/logs/stability-gpu.txt") not passed" | tee -a "$OUT/summary.txt"
   log "ctest -L unit"
   (cd $B && ctest -L unit --output-on-failure -j 16 --timeout 600) > "$OUT/logs/ctest-unit.txt" 2>&1
   log "ctest -L unit rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-unit.txt)"
@@ -101,6 +104,18 @@ if has ico; then
   for i in 1 2 3; do render ico-pixel-$i $ico --strategy pixel; done
   render ico-wavefront $ico --strategy wavefront
   timeout 60 $PB render --device gpu --quiet $ico --strategy pixel --profile | tee -a "$OUT/summary.txt"
+fi
+
+if has accuracy; then
+  # The speed/accuracy sweep on the GPU (pixel strategy: it alone runs every variant).
+  # No Python packages here: FLIP, plots and table are made back home from these files
+  # (tools/accuracy_report.py).
+  for scene in paper-cornell cornell-box; do
+    log "accuracy $scene"
+    timeout 240 $PB accuracy --scene $scene --device gpu --reference-spp 131072 --max-spp 16384 --max-seconds 10 \
+      --no-report-tool --out-dir "$OUT/accuracy/$scene" > "$OUT/logs/accuracy-$scene.txt" 2>&1
+    log "accuracy $scene rc=$?"
+  done
 fi
 
 log "done"
