@@ -110,9 +110,9 @@ if has accuracy; then
   # The speed/accuracy sweep on the GPU (pixel strategy: it alone runs every variant).
   # No Python packages here: FLIP, plots and table are made back home from these files
   # (tools/accuracy_report.py).
-  for scene in paper-cornell cornell-box; do
+  for scene in ${ACCURACY_SCENES:-paper-cornell cornell-box}; do
     log "accuracy $scene"
-    timeout 240 $PB accuracy --scene $scene --device gpu --reference-spp 131072 --max-spp 16384 --max-seconds 10 \
+    timeout ${ACCURACY_TIMEOUT:-240} $PB accuracy --scene $scene --device gpu --reference-spp 131072 --max-spp 16384 --max-seconds 10 \
       --no-report-tool --out-dir "$OUT/accuracy/$scene" > "$OUT/logs/accuracy-$scene.txt" 2>&1
     log "accuracy $scene rc=$?"
   done
