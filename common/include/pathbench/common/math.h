@@ -14,9 +14,14 @@ template <class T> constexpr T kInvPi = T(0.31830988618379067154);
 
 template <class T> struct Vec3 {
   T x, y, z;
+  Vec3() = default;  // trivial: uninitialised, or zero with Vec3{}
+  PB_HD constexpr Vec3(T x_, T y_, T z_) : x(x_), y(y_), z(z_) {}
+  // Between precisions only explicitly: Vec3<double>(a_float_vector). A constructor,
+  // not a conversion operator: with C++20's parenthesised aggregate initialisation
+  // some front ends (nvcc emulating g++ 13) read Vec3<double>(v) as {x = v}.
+  template <class U> PB_HD explicit constexpr Vec3(const Vec3<U>& v) : x(T(v.x)), y(T(v.y)), z(T(v.z)) {}
   PB_HD T operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
   PB_HD T& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
-  template <class U> PB_HD explicit operator Vec3<U>() const { return {U(x), U(y), U(z)}; }
 };
 using Vec3f = Vec3<float>;
 using Vec3d = Vec3<double>;
