@@ -38,7 +38,7 @@ from machine import cpu_model, machine_slug  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 MAX_SLOWDOWN = 0.03
 STRATEGIES = ("pixel", "wavefront")
-TOGGLE = {"pixel": "pb::cpu::render_pixel_parallel(*", "wavefront": "pb::cpu::render_wavefront(*"}
+TOGGLE = {"pixel": "*pb::cpu::render_pixel_parallel<float>(*", "wavefront": "*pb::cpu::render_wavefront<float>(*"}
 
 
 def git_revision():
