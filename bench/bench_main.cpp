@@ -1,6 +1,6 @@
 // pathbench-bench: Google Benchmark harness for pathbench.
 //
-//   pathbench-bench --preset quick|paper|scaling [--benchmark_* options]
+//   pathbench-bench --preset quick|paper|scaling|materials [--benchmark_* options]
 //
 //   quick    smoke run (< 1 min on 2 cores): paper-cornell 64x64, 4 spp, CPU pixel and
 //            wavefront (and GPU where present), uniform and nee; Embree ray casts.
@@ -9,6 +9,7 @@
 //            Embree ray casts on paper-cornell.
 //   scaling  rays/s vs triangle count (scaling:N, N = 10 .. 10^7), time vs spp and
 //            vs resolution (paper-cornell); Embree ray casts on every scaling:N.
+//   materials  diffuse-only against mirror/glass/GGX scenes (materials_bench.h).
 //
 // Regression runs: --benchmark_repetitions=9 --benchmark_report_aggregates_only=false
 // --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`.
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "bench_context.h"
+#include "materials_bench.h"
 #include "raycast_bench.h"
 #include "render_bench.h"
 
@@ -113,7 +115,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) {
     if (i > 0 && std::strcmp(argv[i], "--preset") == 0) {
       if (i + 1 >= argc) {
-        fmt::print(stderr, "pathbench-bench: --preset needs a value (quick, paper or scaling)\n");
+        fmt::print(stderr, "pathbench-bench: --preset needs a value (quick, paper, scaling or materials)\n");
         return 2;
       }
       preset = argv[++i];
@@ -128,8 +130,9 @@ int main(int argc, char** argv) {
   if (preset == "quick") pb::bench::preset_quick();
   else if (preset == "paper") pb::bench::preset_paper();
   else if (preset == "scaling") pb::bench::preset_scaling();
+  else if (preset == "materials") pb::bench::preset_materials();
   else {
-    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper or scaling)\n", preset);
+    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling or materials)\n", preset);
     return 2;
   }
   int new_argc = int(args.size());

@@ -1,17 +1,19 @@
 #!/usr/bin/env python3
 """Independent reference image of paper-cornell (2 bounces, light sampling + MIS)
 from Mitsuba 3, with a per-pixel variance of the mean, for the statistical image
-test (tests/unit/test_statistical_render.cpp).
+test (tests/unit/test_statistical_render.cpp); with --scene cornell-box:VARIANT
+--bounces N, of a cornell-box material variant (tests/unit/test_materials_reference.cpp).
 
     .venv/bin/python tools/make_reference.py            # 32 passes x 512 spp (~20 min on 2 cores)
     .venv/bin/python tools/make_reference.py --passes 8 --spp 64 --out-dir /tmp/ref   # quick
 
 Renders K independent passes (Mitsuba seeds 0 .. K-1) of the scene in
 tools/mitsuba_scene.py, then writes
-    <out-dir>/paper-cornell-nee-ref.pfm       per-pixel mean over the passes (RGB float)
-    <out-dir>/paper-cornell-nee-ref-var.pfm   variance of that mean: sample variance of
-                                               the pass images / K
-    <out-dir>/paper-cornell-nee-ref.json      how it was made
+    <out-dir>/<scene>-nee-ref.pfm       per-pixel mean over the passes (RGB float)
+    <out-dir>/<scene>-nee-ref-var.pfm   variance of that mean: sample variance of
+                                         the pass images / K
+    <out-dir>/<scene>-nee-ref.json      how it was made
+(<scene> with ':' as '-', e.g. cornell-box-ggx).
 Each pass is kept in --cache as it finishes, so an interrupted run resumes.
 """
 from __future__ import annotations
@@ -47,15 +49,21 @@ def main(argv=None):
     ap.add_argument("--spp", type=int, default=512, help="samples per pixel per pass")
     ap.add_argument("--size", type=int, default=ms.WIDTH)
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--scene", default="paper-cornell", help="paper-cornell or cornell-box[:VARIANT] (mitsuba_scene.py)")
+    ap.add_argument("--bounces", type=int, default=ms.MAX_DEPTH - 1, help="pathbench --bounces (max_depth - 1)")
     ap.add_argument("--out-dir", default=str(ROOT / "tests" / "data"))
     ap.add_argument("--cache", default=str(ROOT / "out" / "mitsuba-ref-passes"))
     a = ap.parse_args(argv)
 
     mi = ms.import_mitsuba(a.variant)
-    scene = ms.load_scene(mi, width=a.size, height=a.size, spp=a.spp)
+    max_depth = a.bounces + 1
+    scene = ms.load_scene(mi, width=a.size, height=a.size, spp=a.spp, max_depth=max_depth, scene=a.scene)
     cache = Path(a.cache)
     cache.mkdir(parents=True, exist_ok=True)
+    slug = a.scene.replace(":", "-")
     tag = f"{a.variant}-{a.size}-{a.spp}spp"
+    if a.scene != "paper-cornell" or max_depth != ms.MAX_DEPTH:
+        tag = f"{slug}-depth{max_depth}-{tag}"
     images, seconds = [], 0.0
     for k in range(a.passes):
         f = cache / f"{tag}-seed{k}.npy"
@@ -72,13 +80,13 @@ def main(argv=None):
 
     mean, var = reference_from_passes(np.stack(images))
     out = Path(a.out_dir)
-    stem = "paper-cornell-nee-ref"
+    stem = f"{slug}-nee-ref"
     ms.write_pfm(out / f"{stem}.pfm", mean.astype(np.float32))
     ms.write_pfm(out / f"{stem}-var.pfm", var.astype(np.float32))
     meta = {
-        "scene": "paper-cornell",
+        "scene": a.scene,
         "renderer": f"Mitsuba {mi.__version__}, variant {a.variant}",
-        "integrator": f"path, max_depth {ms.MAX_DEPTH} (pathbench --bounces 2 --sampling nee)",
+        "integrator": f"path, max_depth {max_depth} (pathbench --bounces {a.bounces} --sampling nee)",
         "width": a.size,
         "height": a.size,
         "passes": a.passes,

@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""The paper's Cornell box (pathbench's built-in `paper-cornell`) as a Mitsuba 3 scene.
+"""The paper's Cornell box (pathbench's built-in `paper-cornell`) as a Mitsuba 3 scene,
+and the `cornell-box` variants with mirrors, glass and rough metal
+(tools/mitsuba_cornell_box.py; --scene cornell-box:ggx, say).
 
 An independent renderer for the same scene: ../shared/paper-scene.md gives it exactly
 and common/src/scenes/paper_cornell.cpp builds it for pathbench. Mitsuba's `path`
@@ -122,13 +124,65 @@ def sensor_dict(mi, width=WIDTH, height=HEIGHT, spp=64, seed=0):
     }
 
 
-def scene_dict(mi, width=WIDTH, height=HEIGHT, spp=64, seed=0, max_depth=MAX_DEPTH):
-    """The Mitsuba scene description (a dict for mi.load_dict)."""
+def material_bsdf(m):
+    """pathbench material (tools/mitsuba_cornell_box.py's dicts) -> Mitsuba BSDF dict,
+    each the plugin pathbench's BSDF of that kind is defined as (common/bsdf/)."""
+    rgb = lambda c: {"type": "rgb", "value": list(c)}  # noqa: E731
+    kind = m.get("kind", "diffuse")
+    if m.get("emission") is not None:
+        # Emitters: one-sided, and (in pathbench's scenes) black, as paper-cornell's light.
+        if any(m["albedo"]) or kind != "diffuse":
+            raise ValueError("only black diffuse emitters are exported")
+        return _bsdf((0.0, 0.0, 0.0))
+    if kind == "diffuse":
+        return {"type": "twosided", "material": _bsdf(m["albedo"])}
+    if kind == "mirror":
+        return {"type": "twosided", "material": {"type": "conductor", "material": "none",
+                                                 "specular_reflectance": rgb(m["albedo"])}}
+    if kind == "dielectric":  # two-sided by nature: entering from the front, leaving from the back
+        return {"type": "dielectric", "int_ior": float(m["ior"]), "ext_ior": 1.0,
+                "specular_reflectance": rgb(m["albedo"]), "specular_transmittance": rgb(m["albedo"])}
+    if kind == "roughconductor":
+        return {"type": "twosided", "material": {"type": "roughconductor", "distribution": "ggx",
+                                                 "alpha": float(m["alpha"]), "material": "none",
+                                                 "specular_reflectance": rgb(m["albedo"])}}
+    raise ValueError(f"unknown material kind {kind}")
+
+
+def _integrator(max_depth):
+    # Russian roulette starts after max_depth, i.e. never: pathbench --bounces N has none.
+    return {"type": "path", "max_depth": max_depth, "rr_depth": max(max_depth, 1) + 100, "hide_emitters": False}
+
+
+def cornell_box_dict(mi, variant="", width=WIDTH, height=HEIGHT, spp=64, seed=0, max_depth=MAX_DEPTH):
+    """pathbench's `cornell-box[:variant]` (tools/mitsuba_cornell_box.py) for mi.load_dict."""
+    import mitsuba_cornell_box as cb  # noqa: PLC0415
+
+    origin, target, up, fov = cb.CAMERA
+    sensor = sensor_dict(mi, width, height, spp, seed)
+    sensor["fov"] = fov
+    sensor["near_clip"], sensor["far_clip"] = 1.0, 1e5  # millimetres: the back wall is 1.36 m away
+    sensor["to_world"] = mi.ScalarTransform4f().look_at(origin=origin, target=target, up=up)
+    d = {"type": "scene", "integrator": _integrator(max_depth), "sensor": sensor}
+    for name, verts, faces, m in cb.parts(variant):
+        emitter = None
+        if m.get("emission") is not None:
+            emitter = {"type": "area", "radiance": {"type": "rgb", "value": list(m["emission"])}}
+        d[name] = _mesh(mi, name, verts, faces, material_bsdf(m), emitter)
+    return d
+
+
+def scene_dict(mi, width=WIDTH, height=HEIGHT, spp=64, seed=0, max_depth=MAX_DEPTH, scene="paper-cornell"):
+    """The Mitsuba scene description (a dict for mi.load_dict): paper-cornell (this
+    file's data), or cornell-box / cornell-box:VARIANT."""
+    if scene.startswith("cornell-box"):
+        variant = scene.split(":", 1)[1] if ":" in scene else ""
+        return cornell_box_dict(mi, variant, width, height, spp, seed, max_depth)
+    if scene != "paper-cornell":
+        raise ValueError(f"no Mitsuba version of scene '{scene}' (paper-cornell, cornell-box[:variant])")
     d = {
         "type": "scene",
-        # Russian roulette starts after max_depth, i.e. never: pathbench --bounces 2 has none.
-        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": max(max_depth, 1) + 100,
-                       "hide_emitters": False},
+        "integrator": _integrator(max_depth),
         "sensor": sensor_dict(mi, width, height, spp, seed),
     }
     for name, tris, albedo, emission in PARTS:
@@ -246,6 +300,8 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--size", type=int, default=WIDTH, help="width = height")
     ap.add_argument("--max-depth", type=int, default=MAX_DEPTH)
+    ap.add_argument("--scene", default="paper-cornell", help="paper-cornell or cornell-box[:mirror|glass|spheres|ggx]"
+                    " (--xml writes paper-cornell only)")
     ap.add_argument("--out", help="render to this .pfm")
     ap.add_argument("--xml", help="write scene.xml and PLY meshes into this folder")
     a = ap.parse_args(argv)
@@ -253,7 +309,8 @@ def main(argv=None):
         print(write_xml(a.xml, spp=a.spp, width=a.size, height=a.size))
     if a.out:
         mi = import_mitsuba(a.variant)
-        scene = load_scene(mi, width=a.size, height=a.size, spp=a.spp, seed=a.seed, max_depth=a.max_depth)
+        scene = load_scene(mi, width=a.size, height=a.size, spp=a.spp, seed=a.seed, max_depth=a.max_depth,
+                           scene=a.scene)
         img = render(mi, scene, a.spp, a.seed)
         write_pfm(a.out, img)
         print(f"{a.out}: mean RGB {img.reshape(-1, 3).mean(axis=0)}")

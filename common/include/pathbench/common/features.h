@@ -55,8 +55,11 @@ template <class Fn> decltype(auto) with_features(uint32_t kinds, Fn&& fn) {
   if ((kinds & ~kCompiledMaterialKinds) != 0)
     throw std::logic_error("with_features: the scene uses material kinds this build does not have "
                            "(Scene::finalize should have refused it)");
-  if ((kinds & ~kDiffuseOnly) == 0) return fn(MaterialKinds<kDiffuseOnly>{});
-  return fn(MaterialKinds<kCompiledMaterialKinds>{});
+  // (A diffuse-only build has one instantiation and one call: nothing for the compiler
+  // to weigh differently from a build that never had other kinds.)
+  if constexpr (kCompiledMaterialKinds != kDiffuseOnly)
+    if ((kinds & ~kDiffuseOnly) != 0) return fn(MaterialKinds<kCompiledMaterialKinds>{});
+  return fn(MaterialKinds<kDiffuseOnly>{});
 }
 
 }  // namespace pb

@@ -1,0 +1,121 @@
+// Mirrors, glass and rough metal against Mitsuba 3: the cornell-box variants
+// `cornell-box:ggx` (GGX rough conductor) and `cornell-box:spheres` (mirror and glass
+// spheres), 64 x 64, 4 bounces, light sampling + MIS, compared per pixel with
+// independent Mitsuba references (tests/data/cornell-box-*-nee-ref*.pfm, made by
+// tools/make_reference.py from tools/mitsuba_cornell_box.py; see tests/data/README.md)
+// by the same statistical test as test_statistical_render.cpp. Negative controls: a
+// GGX alpha of 0.3 instead of 0.2, and glass of ior 1.33 instead of 1.5, are rejected.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "pathbench/common/image_io.h"
+#include "pathbench/common/scene_library.h"
+#include "pathbench/cpu/render.h"
+#include "stat_test.h"
+
+namespace pb {
+namespace {
+
+#if PATHBENCH_EXTRA_MATERIALS
+
+constexpr uint32_t kSize = 64;
+constexpr uint32_t kSpp = 1024;
+constexpr int kBounces = 4;                // Mitsuba max_depth 5
+constexpr double kMinShare = 0.99;         // of pixel-channels passing
+constexpr double kMaxMeanError = 0.01;     // per-channel image mean vs the reference
+
+std::string data_path(const std::string& name) { return std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/" + name; }
+
+struct Image {
+  std::vector<float> mean, var;
+  double spp = 0;
+};
+
+Image reference(const std::string& variant) {
+  const std::string stem = "cornell-box-" + variant + "-nee-ref";
+  Image r;
+  unsigned w = 0, h = 0, wv = 0, hv = 0;
+  r.mean = read_image(data_path(stem + ".pfm"), w, h);
+  r.var = read_image(data_path(stem + "-var.pfm"), wv, hv);
+  if (w != kSize || h != kSize || wv != kSize || hv != kSize)
+    throw std::runtime_error(stem + ": reference images are not 64 x 64");
+  std::ifstream meta(data_path(stem + ".json"));
+  const std::string text((std::istreambuf_iterator<char>(meta)), std::istreambuf_iterator<char>());
+  if (const auto pos = text.find("\"spp_total\":"); pos != std::string::npos) r.spp = std::atof(text.c_str() + pos + 12);
+  return r;
+}
+
+Image render(const Scene& scene, uint64_t seed = 1) {
+  RenderSettings s;
+  s.width = s.height = kSize;
+  s.spp = kSpp;
+  s.max_bounces = kBounces;
+  s.sampling = Sampling::Nee;
+  s.strategy = Strategy::Wavefront;
+  s.seed = seed;
+  s.variance = true;
+  s.progress = false;
+  Film film(s.width, s.height, true);
+  RunReport report;
+  cpu::render(scene, s, film, report);
+  EXPECT_EQ(report.discarded_samples, 0u);
+  return {film.mean(), film.variance_of_mean(), double(kSpp)};
+}
+
+stat::ImageTest compare(const Image& ours, const Image& ref) {
+  return stat::compare_images(ours.mean, ours.var, ref.mean, ref.var, 0.01, 1e-4, ref.spp / ours.spp);
+}
+
+bool accepts(const stat::ImageTest& t) {
+  bool means_ok = true;
+  for (int c = 0; c < 3; ++c) means_ok &= std::fabs(t.mean_ratio(c) - 1) <= kMaxMeanError;
+  return t.share_passed() >= kMinShare && means_ok;
+}
+
+void print(const std::string& what, const stat::ImageTest& t) {
+  std::printf("[ stat     ] %s: %s -> %s\n", what.c_str(), t.summary().c_str(), accepts(t) ? "ACCEPTED" : "REJECTED");
+}
+
+class MaterialsReference : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MaterialsReference, MatchesMitsuba) {
+  const std::string variant = GetParam();
+  ASSERT_TRUE(std::filesystem::exists(data_path("cornell-box-" + variant + "-nee-ref.pfm")))
+      << "missing reference (tools/make_reference.py --scene cornell-box:" << variant << " --bounces 4 --size 64)";
+  const stat::ImageTest t = compare(render(make_cornell_box(variant)), reference(variant));
+  print("cornell-box:" + variant + " vs Mitsuba 3", t);
+  EXPECT_GE(t.share_passed(), kMinShare) << t.summary();
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(t.mean_ratio(c), 1.0, kMaxMeanError) << "channel " << "RGB"[c];
+  EXPECT_GT(t.zero_variance, 0u) << "no pixel saw only the light: is the image upside down?";
+  EXPECT_EQ(t.zero_variance_failed, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Variants, MaterialsReference, ::testing::Values("ggx", "spheres"));
+
+// The test can tell a material parameter changed.
+TEST(MaterialsReferenceControls, RejectsOtherParameters) {
+  for (const char* variant : {"ggx", "spheres"}) {
+    if (!std::filesystem::exists(data_path(std::string("cornell-box-") + variant + "-nee-ref.pfm"))) GTEST_SKIP();
+    Scene scene = make_cornell_box(variant);
+    for (Material& m : scene.materials) {
+      if (m.kind == MaterialKind::RoughConductor) m.alpha = 0.3f;
+      if (m.kind == MaterialKind::Dielectric) m.ior = 1.33f;
+    }
+    scene.finalize();
+    const stat::ImageTest t = compare(render(scene), reference(variant));
+    print(std::string("negative control: cornell-box:") + variant + " with other alpha / ior", t);
+    EXPECT_FALSE(accepts(t)) << t.summary();
+  }
+}
+
+#endif  // PATHBENCH_EXTRA_MATERIALS
+
+}  // namespace
+}  // namespace pb
