@@ -250,6 +250,10 @@ int run_accuracy(AccuracyOptions& o) {
         skipped.push_back({{"config", c.name}, {"reason", refusal}});
         break;
       }
+      if (!out["machine"].contains("threads")) {  // what ran the sweep: CPU threads, or the GPU
+        out["machine"]["threads"] = report.threads;
+        if (report.extra.contains("gpu")) out["machine"]["gpu"] = report.extra["gpu"];
+      }
       const std::vector<float> img = film.mean(), var = film.variance_of_mean();
       const double secs = render_seconds(report);
       const ImageError err = image_error(img, ref.mean);
