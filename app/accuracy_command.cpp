@@ -243,14 +243,16 @@ int run_accuracy(AccuracyOptions& o) {
       s.spp = uint32_t(spp);
       Film film(s.width, s.height, true);
       RunReport report;
-      try {
-        render_on_device(scene, s, film, report, false);
-      } catch (const InputError& e) {
-        if (s.device != Device::Gpu) throw;
+      std::string refusal;
+      if (!render_unless_gpu_refuses(scene, s, film, report, refusal)) {
         // The GPU may not run every configuration (e.g. double precision): a note, not a failure.
-        fmt::print(stderr, "accuracy: [{}/{}] {}: skipped, the GPU refuses it: {}\n", k + 1, configs.size(), c.name, e.what());
-        skipped.push_back({{"config", c.name}, {"reason", e.what()}});
+        fmt::print(stderr, "accuracy: [{}/{}] {}: skipped, the GPU refuses it: {}\n", k + 1, configs.size(), c.name, refusal);
+        skipped.push_back({{"config", c.name}, {"reason", refusal}});
         break;
+      }
+      if (!out["machine"].contains("threads")) {  // what ran the sweep: CPU threads, or the GPU
+        out["machine"]["threads"] = report.threads;
+        if (report.extra.contains("gpu")) out["machine"]["gpu"] = report.extra["gpu"];
       }
       const std::vector<float> img = film.mean(), var = film.variance_of_mean();
       const double secs = render_seconds(report);

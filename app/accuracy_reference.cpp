@@ -52,6 +52,18 @@ std::string file_slug(const std::string& name) {
   return out.empty() ? "scene" : out;
 }
 
+bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
+                               std::string& refusal) {
+  try {
+    render_on_device(scene, s, film, report, false);
+    return true;
+  } catch (const InputError& e) {
+    if (s.device != Device::Gpu) throw;
+    refusal = e.what();
+    return false;
+  }
+}
+
 RenderSettings reference_settings(const RenderSettings& base, uint32_t spp) {
   RenderSettings s = base;
   s.spp = spp;
@@ -75,12 +87,10 @@ Reference load_or_render_reference(const Scene& scene, const RenderSettings& bas
 
   Film film(s.width, s.height, true);
   RunReport report;
-  try {
-    render_on_device(scene, s, film, report, false);
-  } catch (const InputError& e) {
-    if (s.device != Device::Gpu) throw;
+  std::string refusal;
+  if (!render_unless_gpu_refuses(scene, s, film, report, refusal)) {
     // A GPU tracer without double precision: the best it has.
-    fmt::print(stderr, "accuracy: reference in double refused by the GPU ({}); rendering it in float\n", e.what());
+    fmt::print(stderr, "accuracy: reference in double refused by the GPU ({}); rendering it in float\n", refusal);
     s.precision = Precision::Float;
     film = Film(s.width, s.height, true);
     render_on_device(scene, s, film, report, false);

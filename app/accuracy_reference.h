@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pathbench/common/film.h"
+#include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
 
@@ -23,6 +25,12 @@ struct Reference {
   std::vector<float> mean, var;  // RGB; var: variance of the per-pixel mean
   nlohmann::json info;           // settings, seconds, file names, whether it came from the cache
 };
+
+// Renders like render_on_device, except that a GPU refusing the settings
+// (InputError, e.g. a tracer without double precision) returns false with the reason
+// instead of throwing: the sweep notes it and goes on. CPU errors still throw.
+bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
+                               std::string& refusal);
 
 // The reference's settings: `base` supplies size, device, strategy and threads.
 RenderSettings reference_settings(const RenderSettings& base, uint32_t spp);

@@ -162,7 +162,9 @@ def markdown(res: dict, stem: str) -> str:
                "finds the hit triangle in float either way and surface_hit recomputes the hit point in the path "
                "step's type.")
     mach = res["machine"]
-    out.append(f"- Machine: {mach['cpu']} ({mach['hardware_threads']} hardware threads), device {res['device']}; "
+    gpu = mach.get("gpu", {}).get("name")
+    device = f"GPU {gpu}" if gpu else f"CPU, {mach.get('threads', '?')} threads"
+    out.append(f"- Machine: {mach['cpu']} ({mach['hardware_threads']} hardware threads); ran on {device}; "
                f"git {res['git_revision']}, {res['compiler']}; {res['date']}. Load average at start "
                f"{load0}, at end {load1}: on a shared machine other work slows some renders, so times (and "
                "efficiencies) carry that noise; the errors do not.")

@@ -58,7 +58,7 @@ def synthetic_run(tmp_path):
     res = {
         "scene": "synthetic", "width": 24, "height": 16, "device": "cpu", "strategy": "pixel", "seed": 1,
         "date": "2026-01-01 00:00 UTC", "git_revision": "abc", "compiler": "gcc",
-        "machine": {"slug": "x", "cpu": "Test CPU", "hardware_threads": 2},
+        "machine": {"slug": "x", "cpu": "Test CPU", "hardware_threads": 2, "threads": 2},
         "load_average_at_start": [0.1, 0.1, 0.1], "load_average_at_end": [1.0, 1.0, 1.0],
         "ladder": {"max_spp": 16, "max_seconds": 5, "factor": 4},
         "metrics": {"rmse": "r", "rel_mse": "m", "rel_mse_eps": 0.01, "bias": "b", "bias_z_threshold": 4,
@@ -91,6 +91,7 @@ def test_whole_run_writes_table_plots_and_flip(tmp_path):
     assert "skipped: the GPU runs float only" in md
     assert "## Bounce budget" in md and "## Path-step precision" in md
     assert "## Sampling" not in md       # no configuration in that group
+    assert "ran on CPU, 2 threads" in md
 
 
 def test_missing_images_leave_flip_out(tmp_path):
