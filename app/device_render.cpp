@@ -30,10 +30,6 @@ void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, R
   }
   std::string why;
   if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
-  // The GPU tracer's path step is instantiated for float only: refuse rather than
-  // render float under a report that says double. (Remove when gpu::render runs T = double.)
-  if (s.precision != Precision::Float)
-    throw InputError("--precision double: the GPU tracer runs the path step in float only");
 #if PATHBENCH_HAVE_CUDA
   gpu::render(scene, s, film, report, profile);
 #else
