@@ -7,6 +7,7 @@
 
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/render.h"
+#include "furnace_check.h"
 
 namespace pb {
 namespace {
@@ -34,24 +35,12 @@ TEST_P(Furnace, MeanMatchesClosedForm) {
   RunReport report;
   cpu::render(scene, s, film, report);
 
-  double expected = 0;
-  if (s.max_bounces < 0) expected = Le / (1 - a);
-  else for (int i = 0; i <= s.max_bounces; ++i) expected += Le * std::pow(a, i);
-
-  const auto mean = film.mean();
-  const auto var = film.variance_of_mean();
-  double sum = 0, var_sum = 0;
-  for (size_t i = 0; i < mean.size(); ++i) {
-    sum += mean[i];
-    var_sum += var[i];
-  }
-  const double n = double(mean.size());
-  const double image_mean = sum / n;
-  const double sigma = std::sqrt(var_sum) / n;  // pixels are independent
+  const double expected = furnace_radiance(a, Le, s.max_bounces);
+  const auto [measured, sigma] = image_mean(film);
   EXPECT_EQ(report.discarded_samples, 0u);
   EXPECT_EQ(report.paths, uint64_t(s.width) * s.height * s.spp);
   // With a zero-variance estimator (e.g. NEE at 0 bounces) sigma is ~0: allow rounding.
-  EXPECT_NEAR(image_mean, expected, 5 * sigma + 1e-5 * expected)
+  EXPECT_NEAR(measured, expected, 5 * sigma + 1e-5 * expected)
       << "sampling " << to_string(s.sampling) << ", bounces " << s.max_bounces << ", sigma " << sigma;
 }
 

@@ -7,18 +7,12 @@
 // GGX alpha of 0.3 instead of 0.2, and glass of ior 1.33 instead of 1.5, are rejected.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
-#include <vector>
 
-#include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
-#include "stat_test.h"
+#include "reference_test.h"
 
 namespace pb {
 namespace {
@@ -31,25 +25,11 @@ constexpr int kBounces = 4;                // Mitsuba max_depth 5
 constexpr double kMinShare = 0.99;         // of pixel-channels passing
 constexpr double kMaxMeanError = 0.01;     // per-channel image mean vs the reference
 
-std::string data_path(const std::string& name) { return std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/" + name; }
-
-struct Image {
-  std::vector<float> mean, var;
-  double spp = 0;
-};
+using reftest::data_path;
+using Image = reftest::Image;
 
 Image reference(const std::string& variant) {
-  const std::string stem = "cornell-box-" + variant + "-nee-ref";
-  Image r;
-  unsigned w = 0, h = 0, wv = 0, hv = 0;
-  r.mean = read_image(data_path(stem + ".pfm"), w, h);
-  r.var = read_image(data_path(stem + "-var.pfm"), wv, hv);
-  if (w != kSize || h != kSize || wv != kSize || hv != kSize)
-    throw std::runtime_error(stem + ": reference images are not 64 x 64");
-  std::ifstream meta(data_path(stem + ".json"));
-  const std::string text((std::istreambuf_iterator<char>(meta)), std::istreambuf_iterator<char>());
-  if (const auto pos = text.find("\"spp_total\":"); pos != std::string::npos) r.spp = std::atof(text.c_str() + pos + 12);
-  return r;
+  return reftest::load_reference("cornell-box-" + variant + "-nee-ref", kSize);
 }
 
 Image render(const Scene& scene, uint64_t seed = 1) {
@@ -60,24 +40,11 @@ Image render(const Scene& scene, uint64_t seed = 1) {
   s.sampling = Sampling::Nee;
   s.strategy = Strategy::Wavefront;
   s.seed = seed;
-  s.variance = true;
-  s.progress = false;
-  Film film(s.width, s.height, true);
-  RunReport report;
-  cpu::render(scene, s, film, report);
-  EXPECT_EQ(report.discarded_samples, 0u);
-  return {film.mean(), film.variance_of_mean(), double(kSpp)};
+  return reftest::render_with_variance(scene, s);
 }
 
-stat::ImageTest compare(const Image& ours, const Image& ref) {
-  return stat::compare_images(ours.mean, ours.var, ref.mean, ref.var, 0.01, 1e-4, ref.spp / ours.spp);
-}
-
-bool accepts(const stat::ImageTest& t) {
-  bool means_ok = true;
-  for (int c = 0; c < 3; ++c) means_ok &= std::fabs(t.mean_ratio(c) - 1) <= kMaxMeanError;
-  return t.share_passed() >= kMinShare && means_ok;
-}
+using reftest::compare;
+bool accepts(const stat::ImageTest& t) { return reftest::accepts(t, kMinShare, kMaxMeanError); }
 
 void print(const std::string& what, const stat::ImageTest& t) {
   std::printf("[ stat     ] %s: %s -> %s\n", what.c_str(), t.summary().c_str(), accepts(t) ? "ACCEPTED" : "REJECTED");

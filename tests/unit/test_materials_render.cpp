@@ -24,15 +24,12 @@
 #include "pathbench/common/features.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/render.h"
+#include "furnace_check.h"
 
 namespace pb {
 namespace {
 
 const std::string kScenes = std::string(PATHBENCH_SOURCE_DIR) + "/scenes/";
-
-struct ImageMean {
-  double mean = 0, sigma = 0;  // over all pixel-channels; sigma of that mean
-};
 
 ImageMean render_mean(const Scene& scene, RenderSettings s, RunReport* report_out = nullptr) {
   s.variance = true;
@@ -41,15 +38,8 @@ ImageMean render_mean(const Scene& scene, RenderSettings s, RunReport* report_ou
   RunReport report;
   cpu::render(scene, s, film, report);
   EXPECT_EQ(report.discarded_samples, 0u) << scene.name;
-  const auto mean = film.mean();
-  const auto var = film.variance_of_mean();
-  double sum = 0, var_sum = 0;
-  for (size_t i = 0; i < mean.size(); ++i) {
-    sum += mean[i];
-    var_sum += var[i];
-  }
   if (report_out) *report_out = report;
-  return {sum / double(mean.size()), std::sqrt(var_sum) / double(mean.size())};
+  return image_mean(film);
 }
 
 RenderSettings settings(Sampling sampling, int bounces, uint32_t size, uint32_t spp) {
@@ -98,9 +88,7 @@ TEST_P(MixedFurnace, MeanMatchesClosedForm) {
   const Scene scene = mixed_furnace(a, Le, c.other);
   ASSERT_EQ(scene.features.material_kinds, kind_bit(MaterialKind::Diffuse) | kind_bit(c.other));
   const ImageMean m = render_mean(scene, settings(c.sampling, c.bounces, 16, 256));
-  double expected = 0;
-  if (c.bounces < 0) expected = Le / (1 - a);
-  else for (int i = 0; i <= c.bounces; ++i) expected += Le * std::pow(a, i);
+  const double expected = furnace_radiance(a, Le, c.bounces);
   EXPECT_NEAR(m.mean, expected, 5 * m.sigma + 1e-5 * expected) << scene.name << ", sigma " << m.sigma;
 }
 

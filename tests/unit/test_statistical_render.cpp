@@ -13,20 +13,11 @@
 // 0.52 instead of 0.5.
 #include <gtest/gtest.h>
 
-#include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <string>
-#include <vector>
 
-#include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
-#include "stat_test.h"
+#include "reference_test.h"
 
 namespace pb {
 namespace {
@@ -36,34 +27,14 @@ constexpr uint32_t kSpp = 128;            // ~5-10 s on 2 cores
 constexpr double kMinShare = 0.99;        // of pixel-channels passing
 constexpr double kMaxMeanError = 0.005;   // per-channel image mean vs the reference
 
-std::string data_path(const char* name) { return std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/" + name; }
-
-struct Reference {
-  std::vector<float> mean, var;
-  double spp = 0;  // total samples per pixel, from the .json beside the images (0: unknown)
-};
+using reftest::data_path;
+using Reference = reftest::Image;
+using Ours = reftest::Image;
 
 const Reference& reference() {
-  static const Reference ref = [] {
-    Reference r;
-    unsigned w = 0, h = 0, wv = 0, hv = 0;
-    r.mean = read_image(data_path("paper-cornell-nee-ref.pfm"), w, h);
-    r.var = read_image(data_path("paper-cornell-nee-ref-var.pfm"), wv, hv);
-    if (w != kSize || h != kSize || wv != kSize || hv != kSize)
-      throw std::runtime_error("tests/data reference images are not 256 x 256");
-    std::ifstream meta(data_path("paper-cornell-nee-ref.json"));
-    std::string text((std::istreambuf_iterator<char>(meta)), std::istreambuf_iterator<char>());
-    const auto pos = text.find("\"spp_total\":");
-    if (pos != std::string::npos) r.spp = std::atof(text.c_str() + pos + 12);
-    return r;
-  }();
+  static const Reference ref = reftest::load_reference("paper-cornell-nee-ref", kSize);
   return ref;
 }
-
-struct Ours {
-  std::vector<float> mean, var;
-  double seconds;
-};
 
 Ours render(const Scene& scene, int bounces, uint64_t seed = 1) {
   RenderSettings s;
@@ -73,24 +44,11 @@ Ours render(const Scene& scene, int bounces, uint64_t seed = 1) {
   s.sampling = Sampling::Nee;
   s.strategy = Strategy::Pixel;
   s.seed = seed;
-  s.variance = true;
-  s.progress = false;
-  Film film(s.width, s.height, true);
-  RunReport report;
-  cpu::render(scene, s, film, report);
-  EXPECT_EQ(report.discarded_samples, 0u);
-  return {film.mean(), film.variance_of_mean(), report.seconds};
+  return reftest::render_with_variance(scene, s);
 }
 
-stat::ImageTest compare(const Ours& ours, const Reference& ref) {
-  return stat::compare_images(ours.mean, ours.var, ref.mean, ref.var, 0.01, 1e-4, ref.spp / kSpp);
-}
-
-bool accepts(const stat::ImageTest& t) {
-  bool means_ok = true;
-  for (int c = 0; c < 3; ++c) means_ok &= std::fabs(t.mean_ratio(c) - 1) <= kMaxMeanError;
-  return t.share_passed() >= kMinShare && means_ok;
-}
+using reftest::compare;
+bool accepts(const stat::ImageTest& t) { return reftest::accepts(t, kMinShare, kMaxMeanError); }
 
 void print(const char* what, const stat::ImageTest& t, double seconds) {
   std::printf("[ stat     ] %s (%u spp, %.1f s): %s -> %s\n", what, kSpp, seconds, t.summary().c_str(),
