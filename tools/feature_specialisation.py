@@ -13,8 +13,9 @@ Both builds are configured and built here (build-feature-on/, build-feature-off/
 CUDA off, targets pathbench and pathbench-bench) unless --on-build / --off-build name
 existing ones. Methods:
   callgrind  instructions executed by the render itself (callgrind, collection toggled
-             on inside pb::cpu::render_pixel_parallel / render_wavefront, one thread),
-             exact and insensitive to other load: the right measure on a shared machine.
+             on inside the diffuse-only instantiation pb::cpu::render_pixel_parallel_for
+             <float, 1u> / render_wavefront_for<float, 1u>, one thread), exact and
+             insensitive to other load: the right measure on a shared machine.
   wallclock  pathbench-bench --preset materials, the paper-cornell CPU rows, the two
              builds interleaved for --rounds rounds of --repetitions each; the ratio of
              median rays/s. Run it on a quiet machine (load average is recorded).
@@ -38,7 +39,11 @@ from machine import cpu_model, machine_slug  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 MAX_SLOWDOWN = 0.03
 STRATEGIES = ("pixel", "wavefront")
-TOGGLE = {"pixel": "*pb::cpu::render_pixel_parallel<float>(*", "wavefront": "*pb::cpu::render_wavefront<float>(*"}
+# The diffuse-only instantiations' entry points, by their full demangled names (a
+# trailing * would also match their lambdas and toggle collection off inside them).
+TOGGLE = {"pixel": "pb::cpu::TraceTotals pb::cpu::render_pixel_parallel_for<float, 1u>(pb::cpu::TraceJob const&)",
+          "wavefront": "pb::cpu::TraceTotals pb::cpu::render_wavefront_for<float, 1u>(pb::cpu::TraceJob const&, "
+                       "unsigned long)"}
 
 
 def git_revision():

@@ -1,3 +1,7 @@
+// Pixel-parallel CPU strategy, compiled for one set of material kinds per translation
+// unit (PB_CPU_KINDS, features.h): diffuse-only here, every kind in
+// render_pixel_all_kinds.cpp. The diffuse-only code is then compiled exactly as in a
+// build without the other kinds (the compiler's inlining budget is per translation unit).
 #include <tbb/blocked_range2d.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
@@ -5,6 +9,10 @@
 #include "embree_rays.h"
 #include "pathbench/common/path.h"
 #include "strategies.h"
+
+#ifndef PB_CPU_KINDS
+#define PB_CPU_KINDS kDiffuseOnly
+#endif
 
 namespace pb::cpu {
 
@@ -49,7 +57,7 @@ Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, 
   return Vec3f(st.L);
 }
 
-template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job) {
+template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& job) {
   const uint32_t w = job.config.width, h = job.config.height;
   tbb::combinable<Local> locals;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
@@ -77,14 +85,15 @@ template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const T
   t.paths_in_flight = 0;  // one per thread, in registers and stack
   return t;
 }
+
 }  // namespace
 
-template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
-  return with_features(job.scene.material_kinds,
-                       [&](auto kinds) { return render_pixel_parallel_for<T, decltype(kinds)::value>(job); });
+// The entry point of this translation unit's instantiations (strategies.h).
+template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job) {
+  return pixel_parallel<T, Kinds>(job);
 }
 
-template TraceTotals render_pixel_parallel<float>(const TraceJob&);
-template TraceTotals render_pixel_parallel<double>(const TraceJob&);
+template TraceTotals render_pixel_parallel_for<float, PB_CPU_KINDS>(const TraceJob&);
+template TraceTotals render_pixel_parallel_for<double, PB_CPU_KINDS>(const TraceJob&);
 
 }  // namespace pb::cpu

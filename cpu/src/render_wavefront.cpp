@@ -4,6 +4,9 @@
 //   can only add emission: emitter query instead of a closest hit) -> intersect (8-wide
 //   packets) -> shade (shared path step) -> shadow (8-wide packets) -> accumulate
 // Memory is the pool, fixed by --paths-in-flight, never width x height x spp.
+// Compiled for one set of material kinds per translation unit (PB_CPU_KINDS,
+// features.h): diffuse-only here, every kind in render_wavefront_all_kinds.cpp, so the
+// diffuse-only code compiles exactly as in a build without the other kinds.
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -14,6 +17,10 @@
 #include "embree_rays.h"
 #include "pathbench/common/path.h"
 #include "strategies.h"
+
+#ifndef PB_CPU_KINDS
+#define PB_CPU_KINDS kDiffuseOnly
+#endif
 
 namespace pb::cpu {
 
@@ -176,7 +183,7 @@ template <class T> void stage_accumulate(const TraceJob& job, PoolSlice<T>& pool
 }
 
 // The stages above, in scalar type T, compiled for the material kinds `Kinds` (features.h).
-template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight) {
+template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   const uint32_t pixels = job.config.width * job.config.height;
   SampleSource source(uint64_t(pixels) * job.spp, pixels);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
@@ -211,12 +218,12 @@ template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJ
 
 }  // namespace
 
-template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
-  return with_features(job.scene.material_kinds,
-                       [&](auto kinds) { return render_wavefront_for<T, decltype(kinds)::value>(job, paths_in_flight); });
+// The entry point of this translation unit's instantiations (strategies.h).
+template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight) {
+  return wavefront<T, Kinds>(job, paths_in_flight);
 }
 
-template TraceTotals render_wavefront<float>(const TraceJob&, uint64_t);
-template TraceTotals render_wavefront<double>(const TraceJob&, uint64_t);
+template TraceTotals render_wavefront_for<float, PB_CPU_KINDS>(const TraceJob&, uint64_t);
+template TraceTotals render_wavefront_for<double, PB_CPU_KINDS>(const TraceJob&, uint64_t);
 
 }  // namespace pb::cpu

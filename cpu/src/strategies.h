@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "pathbench/cpu/embree_scene.h"
+#include "pathbench/common/features.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/progress.h"
 #include "pathbench/common/report.h"
@@ -41,10 +42,21 @@ inline void count_ray(RayCounts& rays, uint32_t depth, uint64_t RayCounts::*othe
 // Both strategies run the path step in the scalar type T (float or double, the
 // --precision setting; instantiated for both in their .cpp files). Embree finds the hit
 // triangle in float either way; surface_hit recomputes the hit in T.
+// Each is compiled per set of material kinds `Kinds` (render_*.cpp and
+// render_*_all_kinds.cpp), and the entry points pick one per render from the scene's
+// features (features.h).
 // One thread per image tile; each pixel sample traced alone (rtcIntersect1/rtcOccluded1).
-template <class T> TraceTotals render_pixel_parallel(const TraceJob& job);
+template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job);
+template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
+  return with_features(job.scene.material_kinds,
+                       [&](auto kinds) { return render_pixel_parallel_for<T, decltype(kinds)::value>(job); });
+}
 // Bounded pool of paths per thread; each stage runs over the whole pool, rays go to
 // Embree in 16-wide packets; finished paths are replaced by new samples.
-template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight);
+template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight);
+template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
+  return with_features(job.scene.material_kinds,
+                       [&](auto kinds) { return render_wavefront_for<T, decltype(kinds)::value>(job, paths_in_flight); });
+}
 
 }  // namespace pb::cpu

@@ -1,0 +1,6 @@
+// The wavefront strategy for scenes with mirrors, glass or rough metal: the same code
+// as render_wavefront.cpp, compiled for every material kind in a translation unit of
+// its own (see there why).
+#include "pathbench/common/features.h"
+#define PB_CPU_KINDS kCompiledMaterialKinds
+#include "render_wavefront.cpp"
