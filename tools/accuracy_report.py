@@ -146,14 +146,18 @@ def markdown(res: dict, stem: str) -> str:
                f"its own seed; {'loaded from the cache' if ref.get('cached') else 'rendered for this run'} "
                f"({ref['file']}, {ref.get('seconds', 0):.1f} s when rendered). Its own noise adds "
                f"{ref['rel_mse_floor']:.2e} to every relative MSE (the floor, dashed in the plot).")
-    out.append(f"- Each configuration renders at 1, 4, 16, ... spp (x{res['ladder']['factor']}) up to "
+    out.append(f"- Each configuration renders at 1, 4, 16, ... spp (x{res['ladder']['factor']}; rung by rung, every "
+               "configuration's rung in turn, so changing load touches all alike) up to "
                f"{res['ladder']['max_spp']} spp, stopping before a render expected to take over "
                f"{res['ladder']['max_seconds']:g} s. Seconds: {m['seconds']}. Every render also accumulates the "
                "per-pixel variance (for the bias's standard error), which costs the same in every configuration.")
     out.append(f"- RMSE: {m['rmse']}. relMSE: {m['rel_mse']}. FLIP: mean LDR-FLIP (flip-evaluator, 67 ppd) of both "
                "images clamped to [0, 1] and sRGB-encoded. Efficiency: " + m["efficiency"] + ".")
     out.append(f"- Bias: {m['bias']}. z = bias / std. error; |z| > {m['bias_z_threshold']:g} is marked **biased** "
-               "(a difference that noise does not explain). Bounded bounce budgets lose the light of longer paths: "
+               "(a difference that noise does not explain); at a few spp the image mean's distribution is skewed by "
+               "rare bright paths, so z is a rough guide there. Every configuration uses the same seed, so their "
+               "noise is correlated and differences between them are resolved better than each one's error bar "
+               "suggests. Bounded bounce budgets lose the light of longer paths: "
                "their bias is negative and stays as spp grows, while their noise falls.")
     out.append("- Intersection: `watertight` is Embree 3's robust mode (RTC_SCENE_FLAG_ROBUST: the Plücker test of "
                "triangle_intersector_pluecker.h, watertight along shared edges, with conservative traversal); "
