@@ -37,7 +37,8 @@ struct Config {
   Sampling sampling;
   bool russian_roulette;
   Precision precision;
-  bool watertight;  // Embree robust mode (Pluecker test) vs its fast mode (Moeller-Trumbore)
+  bool watertight;  // CPU: Embree's robust mode (Pluecker test) vs its fast mode (Moeller-Trumbore);
+                    // GPU: Woop et al.'s watertight test vs Moeller-Trumbore
 };
 
 std::vector<Config> sweep_configs() {
@@ -54,7 +55,7 @@ std::vector<Config> sweep_configs() {
       {"uniform", "uniform hemisphere (the paper's), unbounded + RR", {"sampling"}, -1, Sampling::Uniform, true, F, true},
       {"cosine", "cosine hemisphere, unbounded + RR", {"sampling"}, -1, Sampling::Cosine, true, F, true},
       {"double", "double precision path step", {"precision"}, -1, nee, true, D, true},
-      {"moller-trumbore", "Moeller-Trumbore (Embree fast mode, the paper's test)", {"intersection"}, -1, nee, true, F, false},
+      {"moller-trumbore", "Moeller-Trumbore, the paper's test (CPU: Embree's fast mode)", {"intersection"}, -1, nee, true, F, false},
       {"paper", "the paper's: uniform, 2 bounces, Moeller-Trumbore", {"paper"}, 2, Sampling::Uniform, false, F, false},
   };
 }
