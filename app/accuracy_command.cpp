@@ -37,7 +37,8 @@ struct Config {
   Sampling sampling;
   bool russian_roulette;
   Precision precision;
-  bool watertight;  // Embree robust mode (Pluecker test) vs its fast mode (Moeller-Trumbore)
+  bool watertight;  // CPU: Embree's robust mode (Pluecker test) vs its fast mode (Moeller-Trumbore);
+                    // GPU: Woop et al.'s watertight test vs Moeller-Trumbore
 };
 
 std::vector<Config> sweep_configs() {
@@ -54,7 +55,7 @@ std::vector<Config> sweep_configs() {
       {"uniform", "uniform hemisphere (the paper's), unbounded + RR", {"sampling"}, -1, Sampling::Uniform, true, F, true},
       {"cosine", "cosine hemisphere, unbounded + RR", {"sampling"}, -1, Sampling::Cosine, true, F, true},
       {"double", "double precision path step", {"precision"}, -1, nee, true, D, true},
-      {"moller-trumbore", "Moeller-Trumbore (Embree fast mode, the paper's test)", {"intersection"}, -1, nee, true, F, false},
+      {"moller-trumbore", "Moeller-Trumbore, the paper's test (CPU: Embree's fast mode)", {"intersection"}, -1, nee, true, F, false},
       {"paper", "the paper's: uniform, 2 bounces, Moeller-Trumbore", {"paper"}, 2, Sampling::Uniform, false, F, false},
   };
 }
@@ -230,25 +231,32 @@ int run_accuracy(AccuracyOptions& o) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ref).count(), floor);
 
   nlohmann::json rows = nlohmann::json::array(), cfg_json = nlohmann::json::array(), skipped = nlohmann::json::array();
-  for (size_t k = 0; k < configs.size(); ++k) {
-    const Config& c = configs[k];
-    cfg_json.push_back(config_json(c));
-    RenderSettings s = base;
-    s.max_bounces = c.bounces;
-    s.sampling = c.sampling;
-    s.russian_roulette = c.russian_roulette;
-    s.precision = c.precision;
-    s.watertight = c.watertight;
-    for (uint64_t spp = 1; spp <= o.max_spp; spp *= 4) {
+  for (const Config& c : configs) cfg_json.push_back(config_json(c));
+  // Rungs outermost, configurations inside: on a shared machine the load changes during
+  // the run, and this way a change touches one rung of every configuration alike rather
+  // than the whole ladder of a few.
+  std::vector<bool> climbing(configs.size(), true);
+  for (uint64_t spp = 1; spp <= o.max_spp; spp *= 4) {
+    for (size_t k = 0; k < configs.size(); ++k) {
+      if (!climbing[k]) continue;
+      const Config& c = configs[k];
+      RenderSettings s = base;
+      s.max_bounces = c.bounces;
+      s.sampling = c.sampling;
+      s.russian_roulette = c.russian_roulette;
+      s.precision = c.precision;
+      s.watertight = c.watertight;
       s.spp = uint32_t(spp);
       Film film(s.width, s.height, true);
       RunReport report;
       std::string refusal;
       if (!render_unless_gpu_refuses(scene, s, film, report, refusal)) {
         // The GPU may not run every configuration (e.g. double precision): a note, not a failure.
-        fmt::print(stderr, "accuracy: [{}/{}] {}: skipped, the GPU refuses it: {}\n", k + 1, configs.size(), c.name, refusal);
+        fmt::print(stderr, "accuracy: [{}/{}] {}: skipped, the GPU refuses it: {}\n", k + 1, configs.size(), c.name,
+                   refusal);
         skipped.push_back({{"config", c.name}, {"reason", refusal}});
-        break;
+        climbing[k] = false;
+        continue;
       }
       if (!out["machine"].contains("threads")) {  // what ran the sweep: CPU threads, or the GPU
         out["machine"]["threads"] = report.threads;
@@ -261,26 +269,26 @@ int run_accuracy(AccuracyOptions& o) {
       const Bias bias = relative_bias(img, spp >= 2 ? var : std::vector<float>{}, ref.mean, ref.var);
       const std::string image = fmt::format("{}/{}-{}spp.pfm", image_dir, c.name, spp);
       write_image((fs::path(dir) / image).string(), img, s.width, s.height);
-      nlohmann::json row = {{"config", c.name},
-                            {"spp", spp},
-                            {"seconds", secs},
-                            {"rays", report.rays.total()},
-                            {"rays_per_second", secs > 0 ? double(report.rays.total()) / secs : 0.0},
-                            {"rmse", err.rmse},
-                            {"rel_mse", err.rel_mse},
-                            {"bias", bias.relative},
-                            {"bias_stderr", spp >= 2 ? nlohmann::json(bias.std_error) : nlohmann::json(nullptr)},
-                            {"bias_z", spp >= 2 ? finite_or_null(bias.z()) : nlohmann::json(nullptr)},
-                            {"biased", spp >= 2 ? nlohmann::json(std::fabs(bias.z()) > kBiasZThreshold) : nlohmann::json(nullptr)},
-                            {"efficiency", finite_or_null(efficiency(err.rel_mse, secs))},
-                            {"discarded_samples", report.discarded_samples},
-                            {"state_bytes_per_path", report.state_bytes_per_path},
-                            {"image", image}};
-      rows.push_back(row);
+      const bool has_var = spp >= 2;
+      rows.push_back({{"config", c.name},
+                      {"spp", spp},
+                      {"seconds", secs},
+                      {"rays", report.rays.total()},
+                      {"rays_per_second", secs > 0 ? double(report.rays.total()) / secs : 0.0},
+                      {"rmse", err.rmse},
+                      {"rel_mse", err.rel_mse},
+                      {"bias", bias.relative},
+                      {"bias_stderr", has_var ? nlohmann::json(bias.std_error) : nlohmann::json(nullptr)},
+                      {"bias_z", has_var ? finite_or_null(bias.z()) : nlohmann::json(nullptr)},
+                      {"biased", has_var ? nlohmann::json(std::fabs(bias.z()) > kBiasZThreshold) : nlohmann::json(nullptr)},
+                      {"efficiency", finite_or_null(efficiency(err.rel_mse, secs))},
+                      {"discarded_samples", report.discarded_samples},
+                      {"state_bytes_per_path", report.state_bytes_per_path},
+                      {"image", image}});
       fmt::print(stderr, "accuracy: [{}/{}] {:<16} {:>5} spp {:8.3f} s  relMSE {:.3e}  bias {:+.3f}%{}\n", k + 1,
                  configs.size(), c.name, spp, secs, err.rel_mse, 100 * bias.relative,
-                 spp >= 2 ? fmt::format(" +- {:.3f}%", 100 * bias.std_error) : std::string());
-      if (secs * 4 > o.max_seconds) break;  // the next rung would take about 4x as long
+                 has_var ? fmt::format(" +- {:.3f}%", 100 * bias.std_error) : std::string());
+      if (secs * 4 > o.max_seconds) climbing[k] = false;  // its next rung would take about 4x as long
     }
   }
   out["configurations"] = cfg_json;

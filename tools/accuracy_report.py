@@ -119,7 +119,7 @@ def markdown(res: dict, stem: str) -> str:
         t = seconds_to_reach(rows, "rel_mse", target)
         out.append(f"| {c['label']} | {r['spp']} | {r['seconds']:.3f} | {r['rays_per_second'] / 1e6:.1f} "
                    f"| {r['rel_mse']:.3e} | {fmt_num(r.get('flip'), '.4f')} | {fmt_bias(r)} | {fmt_z(r)} "
-                   f"| {fmt_num(r.get('efficiency'), '.3g')} | {fmt_num(t, '.3f') or 'not reached'} |")
+                   f"| {fmt_num(r.get('efficiency'), '.3g')} | {fmt_num(t, '.3g') or 'not reached'} |")
     for s in res.get("skipped", []):
         out.append(f"| {cfgs.get(s['config'], {}).get('label', s['config'])} | skipped: {s['reason']} "
                    "| | | | | | | | |")
@@ -146,21 +146,30 @@ def markdown(res: dict, stem: str) -> str:
                f"its own seed; {'loaded from the cache' if ref.get('cached') else 'rendered for this run'} "
                f"({ref['file']}, {ref.get('seconds', 0):.1f} s when rendered). Its own noise adds "
                f"{ref['rel_mse_floor']:.2e} to every relative MSE (the floor, dashed in the plot).")
-    out.append(f"- Each configuration renders at 1, 4, 16, ... spp (x{res['ladder']['factor']}) up to "
+    out.append(f"- Each configuration renders at 1, 4, 16, ... spp (x{res['ladder']['factor']}; rung by rung, every "
+               "configuration's rung in turn, so changing load touches all alike) up to "
                f"{res['ladder']['max_spp']} spp, stopping before a render expected to take over "
                f"{res['ladder']['max_seconds']:g} s. Seconds: {m['seconds']}. Every render also accumulates the "
                "per-pixel variance (for the bias's standard error), which costs the same in every configuration.")
     out.append(f"- RMSE: {m['rmse']}. relMSE: {m['rel_mse']}. FLIP: mean LDR-FLIP (flip-evaluator, 67 ppd) of both "
                "images clamped to [0, 1] and sRGB-encoded. Efficiency: " + m["efficiency"] + ".")
     out.append(f"- Bias: {m['bias']}. z = bias / std. error; |z| > {m['bias_z_threshold']:g} is marked **biased** "
-               "(a difference that noise does not explain). Bounded bounce budgets lose the light of longer paths: "
+               "(a difference that noise does not explain); at a few spp the image mean's distribution is skewed by "
+               "rare bright paths, so z is a rough guide there. Every configuration uses the same seed, so their "
+               "noise is correlated and differences between them are resolved better than each one's error bar "
+               "suggests. Bounded bounce budgets lose the light of longer paths: "
                "their bias is negative and stays as spp grows, while their noise falls.")
-    out.append("- Intersection: `watertight` is Embree 3's robust mode (RTC_SCENE_FLAG_ROBUST: the Plücker test of "
-               "triangle_intersector_pluecker.h, watertight along shared edges, with conservative traversal); "
-               "`moller-trumbore` is its default fast mode (triangle_intersector_moeller.h), the paper's test. "
-               "Precision: the path step (camera ray, surface_hit, shading, sampling) runs in float or double; Embree "
-               "finds the hit triangle in float either way and surface_hit recomputes the hit point in the path "
-               "step's type.")
+    if res["device"] == "gpu":
+        out.append("- Intersection (GPU): `watertight` is the watertight ray/triangle test of Woop, Benthin & Wald "
+                   "2013 (common/watertight.h); `moller-trumbore` is the Möller–Trumbore test, the paper's.")
+    else:
+        out.append("- Intersection: `watertight` is Embree 3's robust mode (RTC_SCENE_FLAG_ROBUST: the Plücker test "
+                   "of triangle_intersector_pluecker.h, watertight along shared edges, with conservative traversal); "
+                   "`moller-trumbore` is its default fast mode (triangle_intersector_moeller.h), the paper's test.")
+    out.append("- "
+               "Precision: the path step (camera ray, surface_hit, shading, sampling) runs in float or double; the "
+               "intersector finds the hit triangle in float either way and surface_hit recomputes the hit point in "
+               "the path step's type.")
     mach = res["machine"]
     gpu = mach.get("gpu", {}).get("name")
     device = f"GPU {gpu}" if gpu else f"CPU, {mach.get('threads', '?')} threads"

@@ -4,19 +4,9 @@
 # STATUS 0: a --quick run on paper-cornell -- the JSON has every configuration's rows
 # at 1, 4 and 16 spp, every relative MSE is positive, and a 1-bounce budget is found
 # biased (it loses the light of longer paths).
-if(NOT DEFINED STATUS)
-  set(STATUS 2)
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/run_pathbench.cmake)
 file(REMOVE_RECURSE "${OUT_DIR}")
-execute_process(COMMAND "${PATHBENCH}" accuracy ${ARGS} --out-dir "${OUT_DIR}"
-                RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
-set(failed "")
-if(NOT status STREQUAL "${STATUS}")
-  string(APPEND failed "exit status ${status}, expected ${STATUS}\n")
-endif()
-if(NOT err MATCHES "${EXPECT}")
-  string(APPEND failed "stderr does not match '${EXPECT}'\n")
-endif()
+run_pathbench(accuracy ${ARGS} --out-dir "${OUT_DIR}")
 file(GLOB json "${OUT_DIR}/*-cpu.json")
 if(STATUS STREQUAL "2")
   if(json)

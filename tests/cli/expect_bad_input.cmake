@@ -4,19 +4,9 @@
 #   cmake -DPATHBENCH=<exe> -DOUT=<image> -DREPORT=<report> -DEXPECT=<regex> "-DARGS=a;b;c"
 #         [-DSTATUS=0 -DOUT_MUST_EXIST=ON] -P expect_bad_input.cmake
 # (STATUS/OUT_MUST_EXIST flip it round for the cases that must succeed.)
-if(NOT DEFINED STATUS)
-  set(STATUS 2)
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/run_pathbench.cmake)
 file(REMOVE "${OUT}" "${REPORT}")
-execute_process(COMMAND "${PATHBENCH}" render --quiet ${ARGS}
-                RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
-set(failed "")
-if(NOT status STREQUAL "${STATUS}")
-  string(APPEND failed "exit status ${status}, expected ${STATUS}\n")
-endif()
-if(NOT err MATCHES "${EXPECT}")
-  string(APPEND failed "stderr does not match '${EXPECT}'\n")
-endif()
+run_pathbench(render --quiet ${ARGS})
 if(OUT_MUST_EXIST)
   foreach(f "${OUT}" "${REPORT}")
     if(NOT EXISTS "${f}")
