@@ -242,7 +242,15 @@ def compare(ref, got, o, d, V, T, silhouettes):
     t_pair = both & (~prim_diff | (ties & ~grazing_ties))
     k = np.flatnonzero(t_pair)
     ta, tb = ref["t"][k].astype(np.float64), got["t"][k].astype(np.float64)
-    rel = np.abs(ta - tb) / np.maximum(np.maximum(np.abs(ta), np.abs(tb)), np.finfo(np.float64).tiny)
+    rel = _rel(ta, tb)
+    # Each answer's t against the exact t of its own triangle (double precision on the
+    # float32 inputs). Where the two differ by more than T_REL, a tracer is charged only
+    # if its own t is off the exact one by more than T_REL (the reference can be wrong).
+    ref_exact = exact_t_error(ref, o, d, V, T)
+    got_exact = exact_t_error(got, o, d, V, T)
+    ref_off = ref_exact[k] > T_REL
+    got_off = got_exact[k] > T_REL
+    t_charged = (rel > T_REL) & got_off
     allowed = t_tolerance(o[k], d[k], V[T[ref["prim"][k].astype(np.int64)]], ta)
     strict = hit_miss | (prim_diff & ~(ties & ~grazing_ties))
     disagree = hit_miss | (prim_diff & ~ties)
@@ -261,12 +269,34 @@ def compare(ref, got, o, d, V, T, silhouettes):
         "agreement_strict": float(1.0 - strict.mean()),
         "t_compared": int(len(k)),
         "t_over_1e-5": int((rel > T_REL).sum()),
+        "t_over_1e-5_reference_off": int(((rel > T_REL) & ref_off & ~got_off).sum()),
+        "t_over_1e-5_charged": int(t_charged.sum()),
+        "t_exact_over_1e-5": int((got_exact > T_REL).sum()),
+        "max_t_exact_rel_error": float(got_exact.max()) if got["hit"].any() else 0.0,
+        "reference_t_exact_over_1e-5": int((ref_exact > T_REL).sum()),
+        "reference_max_t_exact_rel_error": float(ref_exact.max()) if ref["hit"].any() else 0.0,
         "t_over_conditioned": int((rel > allowed).sum()),
         "max_t_rel_error": float(rel.max()) if len(rel) else 0.0,
         "max_t_rel_error_well_conditioned": float(rel[allowed <= T_REL].max()) if (allowed <= T_REL).any() else 0.0,
         "disagree_mask": disagree,
+        "strict_mask": strict,
         "t_bad_mask": _scatter(t_pair, rel > allowed),
     }
+
+
+def exact_t_error(answer, o, d, V, T):
+    """Relative error of each hit's t against the exact t (float64, from the float32 ray
+    and vertices) of the triangle it names; 0 where it missed."""
+    err = np.zeros(len(o))
+    h = np.flatnonzero(answer["hit"])
+    if len(h):
+        _, t_exact, _, _ = double_hit(o[h], d[h], V[T[answer["prim"][h].astype(np.int64)]])
+        err[h] = _rel(answer["t"][h].astype(np.float64), t_exact)
+    return err
+
+
+def _rel(a, b):
+    return np.abs(a - b) / np.maximum(np.maximum(np.abs(a), np.abs(b)), np.finfo(np.float64).tiny)
 
 
 def _scatter(mask, values):

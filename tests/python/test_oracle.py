@@ -6,7 +6,10 @@ scene and the GPU BVH traversal run on the host. On each scene, 2^20 rays: rando
 from inside the bounds, from outside, grazing (1e-5 .. 1e-1 rad to a triangle's
 plane) and aimed exactly at edges and vertices. Required: at least 99.99% agreement on
 hit/miss and primitive (a different primitive counts only as a tie checked in double
-precision), and t within 1e-5 relative where both hit (at least 99.99% of those rays).
+precision), and t within 1e-5 relative where both hit (at least 99.99% of those rays;
+where the two differ, the one whose t is off the exact t of its triangle, in double
+precision, is charged: embreex's own t is off by more than 1e-5 on about 2% of hits on
+the scaling scenes). The GPU BVH's t must also be within 1e-5 of the exact t.
 
 PATHBENCH_ORACLE_OUT=<folder> writes oracle.json and oracle.md there (the committed
 summary: results/<machine>/); PATHBENCH_ORACLE_LARGE=1 adds a larger sweep (marked
@@ -35,6 +38,7 @@ except ImportError as e:
 RAYS = 1 << 20
 MIN_AGREEMENT = 0.9999
 BACKENDS = ("embree", "bvh")
+OWN_INTERSECTORS = ("bvh",)  # ours (watertight.h); `embree` is Embree 3's arithmetic
 
 # (label, scene, scale, offset)
 SCENES = [
@@ -85,7 +89,8 @@ def check_scene(label, name, scale, offset, rays, seed=1):
     for backend in BACKENDS:
         got = scene.intersect(o, d, backend=backend)
         c = compare(ref, got, o, d, V, T, silhouettes)
-        disagree, t_bad = c.pop("disagree_mask"), c.pop("t_bad_mask")
+        disagree, t_bad, strict = c.pop("disagree_mask"), c.pop("t_bad_mask"), c.pop("strict_mask")
+        c["strict_disagreements_by_kind"] = {k: int((strict & (kind == i)).sum()) for i, k in enumerate(kinds)}
         c["disagreements_by_kind"] = {k: int((disagree & (kind == i)).sum()) for i, k in enumerate(kinds)}
         c["t_over_conditioned_by_kind"] = {k: int((t_bad & (kind == i)).sum()) for i, k in enumerate(kinds)}
         # occluded() answers the same question as a closest hit: anything in (0, inf),
@@ -99,6 +104,10 @@ def check_scene(label, name, scale, offset, rays, seed=1):
               f"hit/miss {c['hit_miss_mismatches']}  prim {c['prim_mismatches']} (ties {c['ties']}, silhouettes "
               f"{c['silhouettes']})  t>1e-5 {c['t_over_1e-5']} t>cond {c['t_over_conditioned']} of {c['t_compared']}  "
               f"max t rel err {c['max_t_rel_error']:.2e} (well-conditioned {c['max_t_rel_error_well_conditioned']:.2e})  "
+              f"t>1e-5 charged {c['t_over_1e-5_charged']} (reference off {c['t_over_1e-5_reference_off']})  "
+              f"t vs exact >1e-5 {c['t_exact_over_1e-5']} max {c['max_t_exact_rel_error']:.2e} (reference "
+              f"{c['reference_t_exact_over_1e-5']}, max {c['reference_max_t_exact_rel_error']:.2e})  "
+              f"strict disagreements by kind {c['strict_disagreements_by_kind']}  "
               f"disagreements by kind {c['disagreements_by_kind']} t by kind {c['t_over_conditioned_by_kind']}")
     _summary.append(row)
     return row
@@ -109,7 +118,11 @@ def assert_row(row):
         where = f"{row['scene']} / {backend}"
         assert c["rays"] >= 1_000_000, where
         assert c["agreement"] >= MIN_AGREEMENT, f"{where}: agreement {c['agreement']:.6f} ({c})"
-        assert c["t_over_conditioned"] <= (1 - MIN_AGREEMENT) * c["t_compared"], f"{where}: t ({c})"
+        # t within 1e-5 of the reference's, except where the reference's own t is off the
+        # exact one (judged in double) and ours is not.
+        assert c["t_over_1e-5_charged"] <= (1 - MIN_AGREEMENT) * c["t_compared"], f"{where}: t ({c})"
+        if backend in OWN_INTERSECTORS:
+            assert c["t_exact_over_1e-5"] <= (1 - MIN_AGREEMENT) * c["hits"], f"{where}: exact t ({c})"
         assert c["occluded_mismatches"] <= (1 - MIN_AGREEMENT) * c["rays"], f"{where}: occluded ({c})"
         assert c["occluded_before_closest"] <= (1 - MIN_AGREEMENT) * c["rays"], f"{where}: occluded ({c})"
         # The check has teeth: most rays hit something, and no tracer agrees by missing.
@@ -223,20 +236,36 @@ def _markdown(meta, rows):
         "- **ill-cond. touch**: the nearer answer's triangle is met so close to parallel that whether it is hit at "
         "all is within float32 rounding.",
         "",
-        "**agreement** counts all three as agreement; **strict** counts only exact matches and ties. "
-        "t: relative difference where both hit the same triangle (or a tie); **t > cond.** counts differences "
-        "above max(1e-5, 64 ulps x (farthest vertex distance / t) / |cos|), the error float32 input allows.",
+        "**agreement** counts all three as agreement; **strict** counts only exact matches and ties (its "
+        "misses by ray kind follow the table). t, where both hit the same triangle (or a tie): **t > 1e-5** "
+        "counts relative differences above 1e-5 against embreex; **charged** counts those where the backend's "
+        "own t is more than 1e-5 off the exact t of its triangle (double precision on the float32 inputs; the "
+        "rest are embreex's error). **t vs exact** counts, over all of a backend's hits, t more than 1e-5 off the "
+        "exact t, with the largest relative error; embreex's own figures are in its row.",
         "",
         "| scene | tris | backend | rays | on surface | agreement | strict | hit/miss diff | prim diff | ties (ill-cond.) "
-        "| silhouettes | ill-cond. touches | t > 1e-5 | t > cond. | max t rel. err | max where well-cond. |",
+        "| silhouettes | ill-cond. touches | t > 1e-5 | charged | t vs exact > 1e-5 | max t err vs exact |",
         "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
+        first = next(iter(r["backends"].values()))
+        lines.append(
+            f"| {r['scene']} | {r['triangles']} | embreex (reference) | {first['rays']} | "
+            f"{r['origin_on_surface_excluded']} | | | | | | | | | | {first['reference_t_exact_over_1e-5']} / "
+            f"{r['reference_hits']} | {first['reference_max_t_exact_rel_error']:.2e} |")
         for b, c in r["backends"].items():
             lines.append(
                 f"| {r['scene']} | {r['triangles']} | {b} | {c['rays']} | {r['origin_on_surface_excluded']} | "
                 f"{100 * c['agreement']:.4f}% | {100 * c['agreement_strict']:.4f}% | {c['hit_miss_mismatches']} | "
                 f"{c['prim_mismatches']} | {c['ties']} ({c['ties_ill_conditioned']}) | {c['silhouettes']} | "
                 f"{c['ill_conditioned_touches']} | {c['t_over_1e-5']} / {c['t_compared']} | "
-                f"{c['t_over_conditioned']} | {c['max_t_rel_error']:.2e} | {c['max_t_rel_error_well_conditioned']:.2e} |")
+                f"{c['t_over_1e-5_charged']} | {c['t_exact_over_1e-5']} / {c['hits']} | "
+                f"{c['max_t_exact_rel_error']:.2e} |")
+    lines += ["", "Strict disagreements (neither an exact match nor a tie) by ray kind:", "",
+              "| scene | backend | " + " | ".join(first["strict_disagreements_by_kind"]) + " |",
+              "|---|---|" + "---:|" * len(first["strict_disagreements_by_kind"])]
+    for r in rows:
+        for b, c in r["backends"].items():
+            lines.append(f"| {r['scene']} | {b} | " + " | ".join(
+                f"{n} / {r['ray_kinds'][k]}" for k, n in c["strict_disagreements_by_kind"].items()) + " |")
     return "\n".join(lines) + "\n"
