@@ -85,7 +85,12 @@ PB_HD bool intersect_watertight(const WatertightRay& r, const Vec3f& a, const Ve
     W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
   }
   if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
-  if (U + V + W == 0.0f) return false;  // the ray runs in the triangle's plane
+  const float det = U + V + W;
+  if (det == 0.0f) return false;  // the ray runs in the triangle's plane
+  // Behind the origin (Woop's float t is negative): rejected before the double work. Its
+  // sign errs only where the origin lies on the plane to within rounding.
+  const float T = U * (r.sz * Az) + V * (r.sz * Bz) + W * (r.sz * Cz);
+  if (det > 0.0f ? T < 0.0f : T > 0.0f) return false;
   const float th = plane_distance(r.o, r.d, a, b, c);
   if (!(th > 0.0f && th < t_max)) return false;
   t = th;
