@@ -4,8 +4,9 @@
 // from the origin; the 2D edge functions U, V, W of the sheared triangle then decide
 // the hit. Edge functions that come out exactly 0 are recomputed in double, so a ray
 // through a shared edge or vertex hits at least one of the triangles that meet there,
-// on the CPU and the GPU alike. The hit's t then comes from the plane equation in
-// double (plane_distance), not from the edge functions.
+// on the CPU and the GPU alike. Woop's t (a barycentric mean of the vertices' sheared
+// depths) is good enough to order candidates, but its weights cancel on grazing rays;
+// closest-hit traversal replaces the winner's t with plane_distance.
 //
 // Only IEEE +, -, *, / are used (no fused multiply-add: the GPU library is compiled
 // with --fmad=false), so the host and the device compute bit-identical results.
@@ -18,7 +19,7 @@ namespace pb {
 
 // Per-ray constants of the shear transform.
 struct WatertightRay {
-  Vec3f o, d;
+  Vec3f o;
   int kx, ky, kz;
   float sx, sy, sz;
 };
@@ -28,7 +29,6 @@ PB_HD float wt_axis(const Vec3f& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y
 PB_HD WatertightRay make_watertight_ray(const Vec3f& o, const Vec3f& d) {
   WatertightRay r;
   r.o = o;
-  r.d = d;
   const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
   int kz = 2;
   if (ax > ay && ax > az) kz = 0;
@@ -51,11 +51,10 @@ PB_HD WatertightRay make_watertight_ray(const Vec3f& o, const Vec3f& d) {
 }
 
 // The distance along d from o to the plane of (a, b, c), rounded once from double.
-// Woop's own t (a barycentric mean of the vertices' sheared depths) loses up to 1e-2
-// relative on grazing rays, since its weights cancel. The plane equation in double,
-// from the same float inputs, comes within one float ulp of the exact t unless the ray
-// is parallel to the plane to within about 1e-8 rad. Evaluated only for triangles that
-// pass the edge test (a few per ray).
+// Woop's t loses up to 1e-2 relative on grazing rays; the plane equation in double, from
+// the same float inputs, comes within one float ulp of the exact t unless the ray is
+// parallel to the plane to within about 1e-8 rad. Evaluated once per closest hit (every
+// candidate would cost the GPU's megakernel 6%).
 PB_HD float plane_distance(const Vec3f& o, const Vec3f& d, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
   const double ax = a.x, ay = a.y, az = a.z;
   const double e1x = double(b.x) - ax, e1y = double(b.y) - ay, e1z = double(b.z) - az;
@@ -86,15 +85,16 @@ PB_HD bool intersect_watertight(const WatertightRay& r, const Vec3f& a, const Ve
   }
   if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
   const float det = U + V + W;
-  if (det == 0.0f) return false;  // the ray runs in the triangle's plane
-  // Behind the origin (Woop's float t is negative): rejected before the double work. Its
-  // sign errs only where the origin lies on the plane to within rounding.
+  if (det == 0.0f) return false;
   const float T = U * (r.sz * Az) + V * (r.sz * Bz) + W * (r.sz * Cz);
-  if (det > 0.0f ? T < 0.0f : T > 0.0f) return false;
-  const float th = plane_distance(r.o, r.d, a, b, c);
-  if (!(th > 0.0f && th < t_max)) return false;
-  t = th;
-  return true;
+  // 0 < T / det < t_max without dividing (both sides of the sign of det).
+  if (det > 0.0f) {
+    if (!(T > 0.0f) || !(T < t_max * det)) return false;
+  } else {
+    if (!(T < 0.0f) || !(T > t_max * det)) return false;
+  }
+  t = T / det;
+  return t > 0.0f && t < t_max;
 }
 
 }  // namespace pb

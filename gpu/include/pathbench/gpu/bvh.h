@@ -108,6 +108,22 @@ PB_HD float safe_inverse(float d) {
   return 1.0f / (std::fabs(d) > kTiny ? d : (d >= 0.0f ? kTiny : -kTiny));
 }
 
+// The closest hit's answer. Woop's t ordered the candidates; the winner's t comes from
+// the plane equation in double (watertight.h), accurate on grazing rays too.
+template <bool kWatertight>
+PB_HD uint32_t finish_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, uint32_t hit,
+                              uint32_t slot, float t, float& t_hit) {
+  t_hit = t;
+  if (kWatertight && hit != kNoHit) {
+    Vec3f a, b, c;
+    uint32_t prim;
+    load_triangle(bvh.tris, slot, a, b, c, prim);
+    const float exact = plane_distance(o, d, a, b, c);
+    if (exact > 0.0f && exact < t_max) t_hit = exact;
+  }
+  return hit;
+}
+
 }  // namespace detail
 
 // Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
@@ -126,7 +142,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
   uint32_t stack[kTraversalStackSize];
   int sp = 0;
   uint32_t ref = 0;
-  uint32_t hit = kNoHit;
+  uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   for (;;) {
     while (!is_leaf(ref)) {
@@ -151,7 +167,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       } else if (h0 || h1) {
         ref = h0 ? child[0] : child[1];
       } else {
-        if (sp == 0) { t_hit = t; return hit; }
+        if (sp == 0) return detail::finish_closest<kWatertight>(bvh, o, d, t_max, hit, hit_slot, t, t_hit);
         ref = stack[--sp];
       }
     }
@@ -168,14 +184,14 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       if (h) {
         t = tt;
         hit = prim;
+        hit_slot = i;
         if (kAnyHit) { t_hit = t; return hit; }
       }
     }
     if (sp == 0) break;
     ref = stack[--sp];
   }
-  t_hit = t;
-  return hit;
+  return detail::finish_closest<kWatertight>(bvh, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
 template <bool kWatertight = true>
