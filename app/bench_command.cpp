@@ -12,7 +12,9 @@
 namespace pb::app {
 
 void add_bench_options(CLI::App& cmd, BenchOptions& o) {
-  cmd.add_option("--preset", o.preset, "quick (smoke), paper (the 2015 experiment) or scaling")->capture_default_str();
+  cmd.add_option("--preset", o.preset,
+                 "quick (smoke), paper (the 2015 experiment), scaling or materials (diffuse-only vs mixed scenes)")
+      ->capture_default_str();
   cmd.add_option("--out", o.out, "benchmark JSON to write (--benchmark_out)");
   cmd.add_option("--repetitions", o.repetitions, "repetitions per benchmark (regression runs: 9; aggregates and "
                                                  "every repetition are written)");
@@ -21,8 +23,9 @@ void add_bench_options(CLI::App& cmd, BenchOptions& o) {
 }
 
 int run_bench(const BenchOptions& o, const std::vector<std::string>& passthrough) {
-  if (o.preset != "quick" && o.preset != "paper" && o.preset != "scaling")
-    throw InputError(fmt::format("--preset: unknown preset '{}' (expected quick, paper or scaling)", o.preset));
+  if (o.preset != "quick" && o.preset != "paper" && o.preset != "scaling" && o.preset != "materials")
+    throw InputError(
+        fmt::format("--preset: unknown preset '{}' (expected quick, paper, scaling or materials)", o.preset));
   if (o.repetitions < 0) throw InputError("--repetitions: must be >= 0");
   std::error_code ec;
   const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
