@@ -82,13 +82,13 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
   PathState<T> st;
   path_begin(s, c, pixel, sample, st);
   ShadowQuery<T> q;
-  auto occlusion_test = [&] {
+  auto occlusion_test = [&](const ShadowQuery<T>& query) {  // query: q, filled just before
     ++n_shadow;
-    if (!occluded<kWatertight>(bvh, Vec3f(q.ray.o), Vec3f(q.ray.d), 1.0f)) shadow_unoccluded(st, q);
+    if (!occluded<kWatertight>(bvh, Vec3f(query.ray.o), Vec3f(query.ray.d), 1.0f)) shadow_unoccluded(st, query);
   };
   for (;;) {
     if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
-      if (path_final_query<Kinds>(s, c, st, q)) occlusion_test();
+      if (path_final_query<Kinds>(s, c, st, q)) occlusion_test(q);
       break;
     }
     if (st.depth > 0) ++n_bounce;  // the camera ray is counted per path
@@ -97,7 +97,7 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
     if (prim == kNoHit) break;
     bool wants_shadow;
     const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
-    if (wants_shadow) occlusion_test();
+    if (wants_shadow) occlusion_test(q);
     if (ev == PathEvent::Done) break;
   }
   return Vec3f(st.L);
