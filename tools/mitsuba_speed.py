@@ -17,6 +17,11 @@ Mitsuba does not count rays. Its rays per second are an ESTIMATE: its samples pe
 second times pathbench's measured rays per sample for the same estimator (camera ray,
 then at each of the first two hits one shadow ray and one continuation ray).
 
+Each round also runs pathbench-bench's raw Embree ray casts on the same scene, and each
+strategy's rays/s is set against Embree's raw rate for the render's own ray mix
+(tools/raw_embree_mix.py; watertight strategies only: the benchmarks use the tracer's
+robust Embree scene).
+
 Writes results/<machine>/mitsuba-vs-pathbench.json and .md, <machine> being the slug
 pb::machine_slug gives (tools/machine.py).
 """
@@ -36,6 +41,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mitsuba_scene as ms  # noqa: E402
+import raw_embree_mix  # noqa: E402
 from machine import cpu_model, machine_slug  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -171,6 +177,21 @@ def markdown(res):
         lines.append(f"| pathbench cpu/{strategy} | {r['median_seconds']:.2f} "
                      f"({', '.join(f'{s:.2f}' for s in r['seconds'])}) | {px * spp / r['median_seconds'] / 1e6:.2f} M "
                      f"| {r['median_rays_per_second'] / 1e6:.1f} M | {ms_med / r['median_seconds']:.2f}x |")
+    raw = res.get("raw_embree")
+    if raw:
+        lines += ["", "Against Embree's raw ray-cast rate for each render's own ray mix (camera rays as coherent "
+                  "closest hits, bounce rays as incoherent closest hits, shadow rays as incoherent occlusion rays; "
+                  "pathbench-bench raycast benchmarks on this scene, run once per round, medians; aim: 80%):", "",
+                  "| strategy | rays by kind (camera / bounce / shadow) | Embree calls | raw rate, same mix | "
+                  "pathbench rays/s | share of raw |", "|---|---|---|---:|---:|---:|"]
+        for strategy, m_ in raw["mix"].items():
+            r = pb[strategy]
+            lines.append(f"| {strategy} | {r['rays']['camera'] / 1e6:.1f} M / {r['rays']['bounce'] / 1e6:.1f} M / "
+                         f"{r['rays']['shadow'] / 1e6:.1f} M | {m_['calls']} | {m_['raw_rays_per_second'] / 1e6:.1f} M "
+                         f"| {r['median_rays_per_second'] / 1e6:.1f} M | {100 * m_['share']:.0f}% |")
+        lines += ["", "Raw rates (M rays/s): " + ", ".join(
+            f"{n.replace('raycast/cpu/', '').replace('/paper-cornell/real_time', '')} {v / 1e6:.1f}"
+            for n, v in sorted(raw["rates"].items())) + "."]
     lines += [
         "",
         f"Mitsuba's warm-up render (JIT compilation, excluded): {m['warmup_seconds']:.2f} s.",
@@ -198,6 +219,7 @@ def main(argv=None):
     ap.add_argument("--strategies", default="pixel,wavefront,pixel/no-watertight,wavefront/no-watertight",
                     help="strategies, each optionally with flags after '/' (default: both, watertight or not)")
     ap.add_argument("--out-dir", help="default: results/<machine>")
+    ap.add_argument("--no-raw", action="store_true", help="skip the raw Embree ray casts (pathbench-bench)")
     a = ap.parse_args(argv)
     if not Path(a.pathbench).is_file():
         sys.exit(f"{a.pathbench}: not built (run scripts/build.sh, or pass --pathbench)")
@@ -211,6 +233,8 @@ def main(argv=None):
     }
     # Interleaved rounds (Mitsuba, then each pathbench strategy, repeated), so a change
     # of load during the run falls on every renderer alike.
+    bench = Path(a.pathbench).parent / "pathbench-bench"
+    raw_rounds = []
     with tempfile.TemporaryDirectory() as tmp:
         mitsuba = MitsubaRunner(a.spp, a.variant, a.size)
         ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp) for s in a.strategies.split(",")}
@@ -218,8 +242,21 @@ def main(argv=None):
             mitsuba.run()
             for r in ours.values():
                 r.run()
+            if bench.is_file() and not a.no_raw:
+                raw_rounds.append(raw_embree_mix.measure(bench))
+                print("raw Embree: " + ", ".join(f"{n.split('/')[2]}/{n.split('/')[3]} {v / 1e6:.1f} M/s"
+                                                 for n, v in sorted(raw_rounds[-1].items())), flush=True)
         res["mitsuba"] = mitsuba.result()
         res["pathbench"] = {s: r.result() for s, r in ours.items()}
+    if raw_rounds:
+        rates = raw_embree_mix.median_rates(raw_rounds)
+        res["raw_embree"] = {"rates": rates, "rounds": len(raw_rounds), "mix": {}}
+        for s, r in res["pathbench"].items():
+            if s in raw_embree_mix.WIDTH:  # watertight strategies (no flags)
+                raw = raw_embree_mix.mix_rate(r["rays"], rates, s)
+                res["raw_embree"]["mix"][s] = {
+                    "calls": "rtcIntersect1 / rtcOccluded1" if s == "pixel" else "16-wide packets",
+                    "raw_rays_per_second": round(raw), "share": round(r["median_rays_per_second"] / raw, 4)}
     res["load_average_after"] = loadavg()
 
     samples = a.size * a.size * a.spp

@@ -1,11 +1,12 @@
 """Helpers of the Python tools that need no renderer: the machine slug (same rule as
-pb::machine_slug), the reference statistics and the speed report's Markdown."""
+pb::machine_slug), the reference statistics, the speed report's Markdown and its raw-Embree ray mix."""
 import numpy as np
 import pytest
 
 import machine
 import make_reference
 import mitsuba_speed
+import raw_embree_mix
 
 
 @pytest.mark.parametrize("model, slug", [
@@ -55,3 +56,39 @@ def test_speed_markdown():
     assert "| pathbench cpu/pixel | 20.00" in md
     assert "2.00x" in md
     assert "estimate" in md
+
+
+def _rates(camera, bounce, shadow, width):
+    return {raw_embree_mix.bench_name("camera", width): camera, raw_embree_mix.bench_name("bounce", width): bounce,
+            raw_embree_mix.bench_name("shadow", width): shadow}
+
+
+def test_raw_mix_rate_is_the_harmonic_mix():
+    rays = {"camera": 100, "bounce": 50, "shadow": 250, "total": 400}
+    # Equal rates: the mix runs at that rate.
+    assert raw_embree_mix.mix_rate(rays, _rates(8.0, 8.0, 8.0, "1"), "pixel") == pytest.approx(8.0)
+    # Otherwise: total rays over the seconds each kind takes at its own rate.
+    rates = _rates(10.0, 5.0, 25.0, "1") | _rates(20.0, 10.0, 50.0, "16")
+    assert raw_embree_mix.mix_rate(rays, rates, "pixel") == pytest.approx(400 / (10 + 10 + 10))
+    assert raw_embree_mix.mix_rate(rays, rates, "wavefront") == pytest.approx(400 / (5 + 5 + 5))
+
+
+def test_speed_markdown_with_raw_embree():
+    res = {
+        "date": "2026-01-01 00:00 UTC",
+        "machine": {"slug": "x", "cpu": "Test CPU", "hardware_threads": 2},
+        "settings": {"width": 256, "height": 256, "spp": 800},
+        "load_average_before": [0.1, 0.1, 0.1], "load_average_after": [1.0, 1.0, 1.0],
+        "mitsuba": {"renderer": "Mitsuba 3.9.1", "variant": "llvm_ad_rgb", "median_seconds": 40.0,
+                    "seconds": [40.0], "warmup_seconds": 50.0, "estimated_rays_per_second": 5.8e6,
+                    "rays_per_sample_assumed": 4.4, "image_mean_rgb": [0.5, 0.5, 0.45]},
+        "pathbench": {"pixel": {"median_seconds": 20.0, "seconds": [20.0], "median_rays_per_second": 12e6,
+                                "rays": {"camera": 52e6, "bounce": 50e6, "shadow": 85e6, "total": 187e6},
+                                "image_mean_rgb": [0.5, 0.5, 0.45], "git_revision": "abc", "compiler": "gcc"}},
+        "raw_embree": {"rates": _rates(20e6, 16e6, 18e6, "1"), "rounds": 1,
+                       "mix": {"pixel": {"calls": "rtcIntersect1 / rtcOccluded1", "raw_rays_per_second": 16e6,
+                                         "share": 0.75}}},
+    }
+    md = mitsuba_speed.markdown(res)
+    assert "| pixel | 52.0 M / 50.0 M / 85.0 M | rtcIntersect1 / rtcOccluded1 | 16.0 M | 12.0 M | 75% |" in md
+    assert "intersect1/coherent 20.0" in md
