@@ -27,7 +27,7 @@ struct Local {
 // One complete path, single rays: the reference order of operations, in scalar type T
 // and compiled for the material kinds `Kinds` (features.h).
 template <class T, uint32_t Kinds>
-Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
+PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, uint32_t pixel, uint32_t sample, Local& local) {
   PathState<T> st;
   path_begin(job.scene, job.config, pixel, sample, st);
   ShadowQuery<T> q;

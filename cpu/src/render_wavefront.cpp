@@ -81,7 +81,7 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-template <class T> void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice<T>& pool) {
+template <class T> PB_CPU_FLATTEN void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice<T>& pool) {
   uint64_t n = pool.free.size();
   if (n == 0) return;
   const uint64_t start = src.claim(n);
@@ -96,7 +96,7 @@ template <class T> void stage_generate(const TraceJob& job, SampleSource& src, P
 // Paths whose next hit could only add emitted light leave the live list here: their
 // occlusion test (if they face an emitter) joins the shadow stage, and they are done.
 template <class T, uint32_t Kinds>
-void stage_final_vertex(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
   size_t keep = 0;
   for (uint32_t slot : pool.live) {
     const PathState<T>& st = pool.state[slot];
@@ -132,7 +132,7 @@ template <class T> void stage_intersect(const TraceJob& job, PoolSlice<T>& pool,
 }
 
 template <class T, uint32_t Kinds>
-void stage_shade(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_shade(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
   pool.next_live.clear();
   for (uint32_t slot : pool.live) {
     PathState<T>& st = pool.state[slot];

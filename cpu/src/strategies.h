@@ -14,6 +14,10 @@
 
 namespace pb::cpu {
 
+// On the functions that run the path step per path: inline the whole step into them
+// (g++ otherwise keeps path_hit out of line: a call, spills and reloads per vertex).
+#define PB_CPU_FLATTEN [[gnu::flatten]]
+
 struct TraceJob {
   const EmbreeScene& embree;
   SceneView scene;
