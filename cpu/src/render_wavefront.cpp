@@ -12,10 +12,12 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <type_traits>
 #include <vector>
 
 #include "embree_rays.h"
 #include "pathbench/common/path.h"
+#include "shade_x8.h"
 #include "strategies.h"
 
 #ifndef PB_CPU_KINDS
@@ -131,8 +133,49 @@ template <class T> void stage_intersect(const TraceJob& job, PoolSlice<T>& pool,
   }
 }
 
+// Diffuse-only scenes in float (the paper's case): eight paths at a time (shade_x8.h),
+// bit-identical to the scalar path step below.
+PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, Local& local) {
+  pool.next_live.clear();
+  Shade8 batch;
+  auto flush = [&] {
+    for (int i = batch.lanes; i < simd::kLanes; ++i) {  // idle lanes repeat lane 0
+      batch.st[i] = batch.st[0];
+      batch.shadow[i] = batch.shadow[0];
+      batch.prim[i] = batch.prim[0];
+    }
+    shade_diffuse_x8(job.scene, job.config, batch);
+    for (int i = 0; i < batch.lanes; ++i) {
+      const uint32_t slot = uint32_t(batch.st[i] - pool.state.data());
+      if (batch.wants_shadow[i]) {
+        pool.shadowed.push_back(slot);
+        ++local.rays.shadow;
+      }
+      (batch.cont[i] ? pool.next_live : pool.done).push_back(slot);
+    }
+    batch.lanes = 0;
+  };
+  batch.lanes = 0;
+  for (uint32_t slot : pool.live) {
+    if (pool.prim[slot] == RTC_INVALID_GEOMETRY_ID) {
+      pool.done.push_back(slot);
+      continue;
+    }
+    batch.st[batch.lanes] = &pool.state[slot];
+    batch.shadow[batch.lanes] = &pool.shadow[slot];
+    batch.prim[batch.lanes] = pool.prim[slot];
+    if (++batch.lanes == simd::kLanes) flush();
+  }
+  if (batch.lanes > 0) flush();
+  std::swap(pool.live, pool.next_live);
+}
+
 template <class T, uint32_t Kinds>
 PB_CPU_FLATTEN void stage_shade(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
+  if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
+    stage_shade_x8(job, pool, local);
+    return;
+  }
   pool.next_live.clear();
   for (uint32_t slot : pool.live) {
     PathState<T>& st = pool.state[slot];

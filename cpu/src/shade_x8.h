@@ -1,0 +1,180 @@
+#pragma once
+// The CPU wavefront's shading of eight paths at once: surface_hit + path_hit (path.h)
+// for diffuse-only scenes in float, the case the paper's benchmark runs. Per lane it is
+// path_hit's arithmetic in path_hit's order (simd8.h's operations are the lane-wise
+// twins of the scalar ones), so each path gets bit for bit what the scalar path step
+// gives it; the pixel-vs-wavefront tests (tests/unit/test_strategies.cpp) hold the two
+// together. What cannot be done lane-wise -- loads by triangle or material id, the
+// emitter choice, the random numbers, sin/cos -- runs per lane with the scalar code of
+// the path step itself.
+#include <cmath>
+#include <cstdint>
+
+#include "pathbench/common/path.h"
+#include "simd8.h"
+
+namespace pb::cpu {
+
+struct Shade8 {
+  PathState<float>* st[simd::kLanes];
+  ShadowQuery<float>* shadow[simd::kLanes];
+  uint32_t prim[simd::kLanes];  // hit triangle of each lane
+  int lanes;                    // lanes in use; the rest repeat lane 0 and write nothing
+  bool wants_shadow[simd::kLanes];
+  bool cont[simd::kLanes];      // PathEvent::Continue
+};
+
+// path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), *shadow[i], wants_shadow[i])
+// for every lane i.
+inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, Shade8& b) {
+  using namespace simd;
+  constexpr int N = kLanes;
+  const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
+  V3 o, d, beta, L, v0, v1, v2, albedo, Le;
+  V3 l0, l1, l2, le_light;  // the chosen emitter triangle and its emission
+  F8 bsdf_pdf, u0, u1, u_pick, u3;
+  I8 mis_e, emits, scatters;
+  uint32_t vertex[N];
+
+  // Gather, and the per-lane scalar parts of path_hit (which lanes scatter, their
+  // random numbers and emitter choice).
+  for (int i = 0; i < N; ++i) {
+    const PathState<float>& p = *b.st[i];
+    o.x[i] = p.ray.o.x; o.y[i] = p.ray.o.y; o.z[i] = p.ray.o.z;
+    d.x[i] = p.ray.d.x; d.y[i] = p.ray.d.y; d.z[i] = p.ray.d.z;
+    beta.x[i] = p.beta.x; beta.y[i] = p.beta.y; beta.z[i] = p.beta.z;
+    L.x[i] = p.L.x; L.y[i] = p.L.y; L.z[i] = p.L.z;
+    bsdf_pdf[i] = p.bsdf_pdf;
+    const Triangle tri = s.triangles[b.prim[i]];
+    const Vec3f a = s.positions[tri.v[0]], bb = s.positions[tri.v[1]], cc = s.positions[tri.v[2]];
+    v0.x[i] = a.x; v0.y[i] = a.y; v0.z[i] = a.z;
+    v1.x[i] = bb.x; v1.y[i] = bb.y; v1.z[i] = bb.z;
+    v2.x[i] = cc.x; v2.y[i] = cc.y; v2.z[i] = cc.z;
+    const Material& m = s.material_of(b.prim[i]);
+    Le.x[i] = m.emission.x; Le.y[i] = m.emission.y; Le.z[i] = m.emission.z;
+    albedo.x[i] = m.albedo.x; albedo.y[i] = m.albedo.y; albedo.z[i] = m.albedo.z;
+    emits[i] = is_zero(m.emission) ? 0 : -1;
+    mis_e[i] = (c.sampling == Sampling::Nee && p.depth > 0) ? -1 : 0;
+    const bool at_budget = c.max_bounces >= 0 && p.depth >= uint32_t(c.max_bounces);
+    scatters[i] = (!at_budget && !is_zero(m.albedo)) ? -1 : 0;
+    vertex[i] = p.depth + 1;
+    Uniform4 ub{{0.0f, 0.0f, 0.0f, 0.0f}};
+    if (scatters[i]) ub = RngStream{p.pixel, c.seed}.draw(p.sample, vertex[i], kRngVertex);
+    u0[i] = ub.v[0]; u1[i] = ub.v[1]; u3[i] = ub.v[3];
+    float up = ub.v[2];
+    uint32_t light = b.prim[i];  // any valid triangle where no emitter is chosen
+    if (nee && scatters[i]) light = s.emitters[pick_emitter(s, up)];
+    u_pick[i] = up;
+    const Triangle lt = s.triangles[light];
+    const Vec3f la = s.positions[lt.v[0]], lb = s.positions[lt.v[1]], lc = s.positions[lt.v[2]];
+    l0.x[i] = la.x; l0.y[i] = la.y; l0.z[i] = la.z;
+    l1.x[i] = lb.x; l1.y[i] = lb.y; l1.z[i] = lb.z;
+    l2.x[i] = lc.x; l2.y[i] = lc.y; l2.z[i] = lc.z;
+    const Vec3f lle = s.material_of(light).emission;
+    le_light.x[i] = lle.x; le_light.y[i] = lle.y; le_light.z[i] = lle.z;
+  }
+
+  // surface_hit (surface_hit.h).
+  const V3 e1 = v1 - v0, e2 = v2 - v0;
+  const V3 pv = cross(d, e2);
+  const F8 inv_det = 1.0f / dot(e1, pv);
+  const V3 tv = o - v0;
+  F8 b1 = dot(tv, pv) * inv_det;
+  const V3 qv = cross(tv, e1);
+  F8 b2 = dot(d, qv) * inv_det;
+  const F8 t = dot(e2, qv) * inv_det;
+  b1 = vmin(vmax(b1, F8{}), splat(1.0f));
+  b2 = vmin(vmax(b2, F8{}), 1.0f - b1);
+  const V3 p = v0 + e1 * b1 + e2 * b2;
+  const V3 ng = normalize(cross(e1, e2));
+
+  // 1. Emission, MIS-weighted after the first vertex (emitted_radiance).
+  const F8 cos_o = -dot(ng, d);
+  const F8 pdf_e = mean3(Le) / s.emitter_power_total * t * t / cos_o;
+  const F8 w_e = select(mis_e, power_heuristic(bsdf_pdf, pdf_e), splat(1.0f));
+  L = select((cos_o > 0.0f) & emits, L + beta * Le * w_e, L);
+
+  // 2.-5. For the lanes that scatter.
+  const V3 n = select(cos_o >= 0.0f, ng, -ng);
+  const Frame8 frame = Frame8::from_normal(n);
+  const V3 origin = offset_ray_origin(p, n, s.offset);
+
+  // 3. Light sampling.
+  I8 shadow = I8{};
+  V3 contribution, shadow_d;
+  if (nee) {
+    const V3 le1 = l1 - l0, le2 = l2 - l0;
+    const F8 su = sqrt(u_pick);
+    const F8 tb1 = 1.0f - su, tb2 = u3 * su;
+    const V3 y = l0 + le1 * tb1 + le2 * tb2;
+    const V3 nl = normalize(cross(le1, le2));
+    V3 wi = y - p;
+    const F8 dist2 = dot(wi, wi);
+    wi = wi / sqrt(dist2);
+    const F8 cos_s = dot(n, wi);
+    const F8 cos_l = -dot(nl, wi);
+    shadow = scatters & (cos_s > 0.0f) & (cos_l > 0.0f) & (dist2 > 0.0f);
+    const F8 pdf_light = mean3(le_light) / s.emitter_power_total * dist2 / cos_l;
+    const V3 f = albedo * splat(kInvPi<float>);
+    const F8 f_pdf = vmax(cos_s, F8{}) * kInvPi<float>;
+    const F8 w = power_heuristic(pdf_light, f_pdf);
+    contribution = beta * f * le_light * (cos_s * w / pdf_light);
+    shadow_d = offset_ray_origin(y, nl, s.offset) - origin;
+  }
+
+  // 4. Next direction: lambert_sample (bsdf/lambert.h).
+  F8 r, z, pdf;
+  if (c.sampling == Sampling::Uniform) {
+    z = u0;
+    r = sqrt(vmax(F8{}, 1.0f - z * z));
+    pdf = splat(uniform_hemisphere_pdf<float>());
+  } else {
+    r = sqrt(u0);
+    z = sqrt(vmax(F8{}, 1.0f - u0));
+    pdf = vmax(z, F8{}) * kInvPi<float>;
+  }
+  const F8 phi = 2.0f * kPi<float> * u1;
+  F8 cos_phi, sin_phi;
+  for (int i = 0; i < N; ++i) {
+    cos_phi[i] = std::cos(phi[i]);
+    sin_phi[i] = std::sin(phi[i]);
+  }
+  const V3 local{r * cos_phi, r * sin_phi, z};
+  I8 cont = scatters & (pdf > 0.0f) & (z > 0.0f);
+  V3 beta_next = beta * (albedo * splat(kInvPi<float>) * (z / pdf));
+  const V3 wi_next = frame.to_world(local);
+
+  // 5. Russian roulette.
+  if (c.russian_roulette) {
+    const F8 q = vmin(vmax(beta_next.x, vmax(beta_next.y, beta_next.z)), splat(0.95f));
+    I8 rr = I8{};
+    for (int i = 0; i < N; ++i) {
+      if (!cont[i] || vertex[i] < c.rr_start_depth) continue;
+      rr[i] = -1;
+      const PathState<float>& ps = *b.st[i];
+      if (!(RngStream{ps.pixel, c.seed}.draw(ps.sample, vertex[i], kRngRoulette).v[0] < q[i])) cont[i] = 0;
+    }
+    beta_next = select(rr, beta_next / q, beta_next);
+  }
+
+  // Scatter back.
+  for (int i = 0; i < b.lanes; ++i) {
+    PathState<float>& ps = *b.st[i];
+    ps.L = {L.x[i], L.y[i], L.z[i]};
+    b.wants_shadow[i] = shadow[i] != 0;
+    if (shadow[i]) {
+      ShadowQuery<float>& q = *b.shadow[i];
+      q.ray = {{origin.x[i], origin.y[i], origin.z[i]}, {shadow_d.x[i], shadow_d.y[i], shadow_d.z[i]}};
+      q.contribution = {contribution.x[i], contribution.y[i], contribution.z[i]};
+    }
+    b.cont[i] = cont[i] != 0;
+    if (cont[i]) {
+      ps.ray = {{origin.x[i], origin.y[i], origin.z[i]}, {wi_next.x[i], wi_next.y[i], wi_next.z[i]}};
+      ps.beta = {beta_next.x[i], beta_next.y[i], beta_next.z[i]};
+      ps.bsdf_pdf = pdf[i];
+      ps.depth = vertex[i];
+    }
+  }
+}
+
+}  // namespace pb::cpu

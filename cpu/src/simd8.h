@@ -1,0 +1,86 @@
+#pragma once
+// Eight float lanes for the CPU wavefront's batched shading (shade_x8.h), written with
+// GCC's vector extensions: AVX registers where the build has them, pairs of SSE
+// registers otherwise. Every operation here is the lane-wise twin of the scalar one the
+// path step uses (IEEE +, -, *, /, sqrt, compare-and-select; no FMA, -ffp-contract=off),
+// so a lane computes bit for bit what the scalar path step computes for that path.
+#include <immintrin.h>
+
+#include <cstdint>
+#include <cstring>
+
+#include "pathbench/common/math.h"
+
+namespace pb::cpu::simd {
+
+constexpr int kLanes = 8;
+typedef float F8 __attribute__((vector_size(32)));
+typedef int32_t I8 __attribute__((vector_size(32)));  // masks: -1 (true) or 0
+using V3 = Vec3<F8>;                                    // math.h's +, -, *, dot, cross work lane-wise
+
+inline F8 splat(float x) { return F8{} + x; }
+inline I8 splat_i(int32_t x) { return I8{} + x; }
+inline I8 bits(F8 v) { return (I8)v; }  // a cast between vector types of one size keeps the bits
+inline F8 from_bits(I8 v) { return (F8)v; }
+// m ? a : b per lane (m from a comparison).
+inline F8 select(I8 m, F8 a, F8 b) { return m ? a : b; }
+inline V3 select(I8 m, V3 a, V3 b) { return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z}; }
+// pmin / pmax of math.h, lane-wise: the same comparison picks the same operand (NaN too).
+inline F8 vmin(F8 a, F8 b) { return a < b ? a : b; }
+inline F8 vmax(F8 a, F8 b) { return a > b ? a : b; }
+inline bool any(I8 m) {
+  for (int i = 0; i < kLanes; ++i)
+    if (m[i]) return true;
+  return false;
+}
+
+inline F8 sqrt(F8 a) {
+#if defined(__AVX__)
+  return F8(_mm256_sqrt_ps(__m256(a)));
+#else
+  __m128 h[2];
+  std::memcpy(h, &a, sizeof a);
+  h[0] = _mm_sqrt_ps(h[0]);
+  h[1] = _mm_sqrt_ps(h[1]);
+  std::memcpy(&a, h, sizeof a);
+  return a;
+#endif
+}
+inline F8 abs(F8 a) { return from_bits(bits(a) & 0x7fffffff); }
+inline F8 copysign(F8 mag, F8 sign) { return from_bits((bits(mag) & 0x7fffffff) | (bits(sign) & int32_t(0x80000000u))); }
+
+// As math.h: a * (1 / length(a)).
+inline V3 normalize(V3 a) { return a * (1.0f / sqrt(dot(a, a))); }
+
+// Frame<T>::from_normal (math.h), lane-wise, in the same order of operations.
+struct Frame8 {
+  V3 s, t, n;
+  static Frame8 from_normal(V3 n) {
+    const F8 sign = copysign(splat(1.0f), n.z);
+    const F8 a = -1.0f / (sign + n.z);
+    const F8 b = n.x * n.y * a;
+    return {{1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
+  }
+  V3 to_world(V3 v) const { return s * v.x + t * v.y + n * v.z; }
+};
+
+// offset_ray_origin (ray_offset.h) lane-wise: the float-grid move along n.
+inline F8 offset_coord(F8 pc, F8 nc, const RayOffset& off) {
+  const F8 near_moved = pc + off.fixed_distance * nc;
+  const I8 of = __builtin_convertvector(256.0f * nc, I8);  // truncation, as int32_t(float)
+  const I8 far_bits = bits(pc) + ((pc < 0.0f) ? -of : of);
+  return select(abs(pc) < off.near_origin, near_moved, from_bits(far_bits));
+}
+inline V3 offset_ray_origin(V3 p, V3 n, const RayOffset& off) {
+  return {offset_coord(p.x, n.x, off), offset_coord(p.y, n.y, off), offset_coord(p.z, n.z, off)};
+}
+
+// power_heuristic (sampling.h) lane-wise.
+inline F8 power_heuristic(F8 pdf_a, F8 pdf_b) {
+  const F8 a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+  return select(a > 0.0f, a / (a + b), splat(0.0f));
+}
+
+inline F8 mean3(V3 v) { return (v.x + v.y + v.z) * float(1.0 / 3.0); }
+
+}  // namespace pb::cpu::simd
