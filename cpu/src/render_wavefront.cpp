@@ -17,8 +17,16 @@
 
 #include "embree_rays.h"
 #include "pathbench/common/path.h"
-#include "shade_x8.h"
 #include "strategies.h"
+
+// The batched shading (shade_x8.h), compiled for AVX2 whatever the build's baseline;
+// used where the CPU has AVX2 (checked at run time), the scalar path step elsewhere.
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#define PB_SIMD_NS avx2
+#include "shade_x8.h"
+#undef PB_SIMD_NS
+#pragma GCC pop_options
 
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly
@@ -133,18 +141,18 @@ template <class T> void stage_intersect(const TraceJob& job, PoolSlice<T>& pool,
   }
 }
 
-// Diffuse-only scenes in float (the paper's case): eight paths at a time (shade_x8.h),
-// bit-identical to the scalar path step below.
+// Diffuse-only scenes in float (the paper's case) on AVX2 CPUs: eight paths at a time
+// (shade_x8.h), bit-identical to the scalar path step below.
 PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, Local& local) {
   pool.next_live.clear();
   Shade8 batch;
   auto flush = [&] {
-    for (int i = batch.lanes; i < simd::kLanes; ++i) {  // idle lanes repeat lane 0
+    for (int i = batch.lanes; i < kShadeLanes; ++i) {  // idle lanes repeat lane 0
       batch.st[i] = batch.st[0];
       batch.shadow[i] = batch.shadow[0];
       batch.prim[i] = batch.prim[0];
     }
-    shade_diffuse_x8(job.scene, job.config, batch);
+    avx2::shade_diffuse_x8(job.scene, job.config, batch);
     for (int i = 0; i < batch.lanes; ++i) {
       const uint32_t slot = uint32_t(batch.st[i] - pool.state.data());
       if (batch.wants_shadow[i]) {
@@ -164,7 +172,7 @@ PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, 
     batch.st[batch.lanes] = &pool.state[slot];
     batch.shadow[batch.lanes] = &pool.shadow[slot];
     batch.prim[batch.lanes] = pool.prim[slot];
-    if (++batch.lanes == simd::kLanes) flush();
+    if (++batch.lanes == kShadeLanes) flush();
   }
   if (batch.lanes > 0) flush();
   std::swap(pool.live, pool.next_live);
@@ -173,8 +181,11 @@ PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, 
 template <class T, uint32_t Kinds>
 PB_CPU_FLATTEN void stage_shade(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
   if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
-    stage_shade_x8(job, pool, local);
-    return;
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2) {
+      stage_shade_x8(job, pool, local);
+      return;
+    }
   }
   pool.next_live.clear();
   for (uint32_t slot : pool.live) {

@@ -1,4 +1,3 @@
-#pragma once
 // The CPU wavefront's shading of eight paths at once: surface_hit + path_hit (path.h)
 // for diffuse-only scenes in float, the case the paper's benchmark runs. Per lane it is
 // path_hit's arithmetic in path_hit's order (simd8.h's operations are the lane-wise
@@ -7,44 +6,64 @@
 // together. What cannot be done lane-wise -- loads by triangle or material id, the
 // emitter choice, the random numbers, sin/cos -- runs per lane with the scalar code of
 // the path step itself.
+//
+// Included in a namespace named by PB_SIMD_NS under `#pragma GCC target("avx2")`
+// (render_wavefront.cpp): eight lanes are one AVX register. (Compiled for the SSE2
+// baseline, every vector operation is two SSE ones, the lane shuffles are scalar code,
+// and the batch costs more than the scalar path step; g++ 12 also fails on an SSE2 and
+// an AVX2 copy in one translation unit.)
 #include <cmath>
 #include <cstdint>
 
 #include "pathbench/common/path.h"
 #include "simd8.h"
 
+#ifndef PB_CPU_SHADE8_DEFINED
+#define PB_CPU_SHADE8_DEFINED
 namespace pb::cpu {
-
+constexpr int kShadeLanes = 8;
+// One batch: eight paths that hit a triangle, and what shading them asks for next.
 struct Shade8 {
-  PathState<float>* st[simd::kLanes];
-  ShadowQuery<float>* shadow[simd::kLanes];
-  uint32_t prim[simd::kLanes];  // hit triangle of each lane
-  int lanes;                    // lanes in use; the rest repeat lane 0 and write nothing
-  bool wants_shadow[simd::kLanes];
-  bool cont[simd::kLanes];      // PathEvent::Continue
+  PathState<float>* st[kShadeLanes];
+  ShadowQuery<float>* shadow[kShadeLanes];
+  uint32_t prim[kShadeLanes];  // hit triangle of each lane
+  int lanes;                   // lanes in use; the rest repeat lane 0 and write nothing
+  bool wants_shadow[kShadeLanes];
+  bool cont[kShadeLanes];      // PathEvent::Continue
 };
+}  // namespace pb::cpu::PB_SIMD_NS
+#endif
+
+namespace pb::cpu::PB_SIMD_NS {
 
 // path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), *shadow[i], wants_shadow[i])
 // for every lane i.
-inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, Shade8& b) {
-  using namespace simd;
+[[gnu::noinline, gnu::flatten]] inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, Shade8& b) {
   constexpr int N = kLanes;
   const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
-  V3 o, d, beta, L, v0, v1, v2, albedo, Le;
+  V3 v0, v1, v2, albedo, Le;
   V3 l0, l1, l2, le_light;  // the chosen emitter triangle and its emission
-  F8 bsdf_pdf, u0, u1, u_pick, u3;
-  I8 mis_e, emits, scatters;
-  uint32_t vertex[N];
+  F8 u0, u1, u_pick, u3;
+  I8 emits, scatters;
 
-  // Gather, and the per-lane scalar parts of path_hit (which lanes scatter, their
-  // random numbers and emitter choice).
+  // The paths' states, one lane each (PathState<float> is two 8-float rows).
+  static_assert(sizeof(PathState<float>) == 2 * sizeof(F8), "PathState<float>: 16 floats, as the rows below");
+  const void* rows[N];
+  for (int i = 0; i < N; ++i) rows[i] = b.st[i];
+  F8 ra[N], rb[N];
+  load_rows(rows, 0, ra);
+  load_rows(rows, 8, rb);
+  const V3 o{ra[0], ra[1], ra[2]}, d{ra[3], ra[4], ra[5]};
+  const V3 beta{ra[6], ra[7], rb[0]};
+  V3 L{rb[1], rb[2], rb[3]};
+  const F8 bsdf_pdf = rb[4];
+  const I8 pixel = bits(rb[5]), sample = bits(rb[6]), depth = bits(rb[7]);
+  const I8 vertex = depth + 1;
+  const I8 mis_e = c.sampling == Sampling::Nee ? (depth > 0) : I8{};
+
+  // Per lane: the hit triangle and its material, which lanes scatter, their random
+  // numbers and emitter choice.
   for (int i = 0; i < N; ++i) {
-    const PathState<float>& p = *b.st[i];
-    o.x[i] = p.ray.o.x; o.y[i] = p.ray.o.y; o.z[i] = p.ray.o.z;
-    d.x[i] = p.ray.d.x; d.y[i] = p.ray.d.y; d.z[i] = p.ray.d.z;
-    beta.x[i] = p.beta.x; beta.y[i] = p.beta.y; beta.z[i] = p.beta.z;
-    L.x[i] = p.L.x; L.y[i] = p.L.y; L.z[i] = p.L.z;
-    bsdf_pdf[i] = p.bsdf_pdf;
     const Triangle tri = s.triangles[b.prim[i]];
     const Vec3f a = s.positions[tri.v[0]], bb = s.positions[tri.v[1]], cc = s.positions[tri.v[2]];
     v0.x[i] = a.x; v0.y[i] = a.y; v0.z[i] = a.z;
@@ -54,12 +73,10 @@ inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, Shade8& b)
     Le.x[i] = m.emission.x; Le.y[i] = m.emission.y; Le.z[i] = m.emission.z;
     albedo.x[i] = m.albedo.x; albedo.y[i] = m.albedo.y; albedo.z[i] = m.albedo.z;
     emits[i] = is_zero(m.emission) ? 0 : -1;
-    mis_e[i] = (c.sampling == Sampling::Nee && p.depth > 0) ? -1 : 0;
-    const bool at_budget = c.max_bounces >= 0 && p.depth >= uint32_t(c.max_bounces);
+    const bool at_budget = c.max_bounces >= 0 && uint32_t(depth[i]) >= uint32_t(c.max_bounces);
     scatters[i] = (!at_budget && !is_zero(m.albedo)) ? -1 : 0;
-    vertex[i] = p.depth + 1;
     Uniform4 ub{{0.0f, 0.0f, 0.0f, 0.0f}};
-    if (scatters[i]) ub = RngStream{p.pixel, c.seed}.draw(p.sample, vertex[i], kRngVertex);
+    if (scatters[i]) ub = RngStream{uint32_t(pixel[i]), c.seed}.draw(uint32_t(sample[i]), uint32_t(vertex[i]), kRngVertex);
     u0[i] = ub.v[0]; u1[i] = ub.v[1]; u3[i] = ub.v[3];
     float up = ub.v[2];
     uint32_t light = b.prim[i];  // any valid triangle where no emitter is chosen
@@ -149,32 +166,35 @@ inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, Shade8& b)
     const F8 q = vmin(vmax(beta_next.x, vmax(beta_next.y, beta_next.z)), splat(0.95f));
     I8 rr = I8{};
     for (int i = 0; i < N; ++i) {
-      if (!cont[i] || vertex[i] < c.rr_start_depth) continue;
+      if (!cont[i] || uint32_t(vertex[i]) < c.rr_start_depth) continue;
       rr[i] = -1;
-      const PathState<float>& ps = *b.st[i];
-      if (!(RngStream{ps.pixel, c.seed}.draw(ps.sample, vertex[i], kRngRoulette).v[0] < q[i])) cont[i] = 0;
+      const RngStream rng{uint32_t(pixel[i]), c.seed};
+      if (!(rng.draw(uint32_t(sample[i]), uint32_t(vertex[i]), kRngRoulette).v[0] < q[i])) cont[i] = 0;
     }
     beta_next = select(rr, beta_next / q, beta_next);
   }
 
-  // Scatter back.
+  // Back to the states: radiance always, the rest where the path goes on.
+  ra[0] = select(cont, origin.x, ra[0]); ra[1] = select(cont, origin.y, ra[1]); ra[2] = select(cont, origin.z, ra[2]);
+  ra[3] = select(cont, wi_next.x, ra[3]); ra[4] = select(cont, wi_next.y, ra[4]); ra[5] = select(cont, wi_next.z, ra[5]);
+  ra[6] = select(cont, beta_next.x, ra[6]); ra[7] = select(cont, beta_next.y, ra[7]);
+  rb[0] = select(cont, beta_next.z, rb[0]);
+  rb[1] = L.x; rb[2] = L.y; rb[3] = L.z;
+  rb[4] = select(cont, pdf, rb[4]);
+  rb[7] = from_bits(cont ? vertex : depth);
+  transpose8(ra);
+  transpose8(rb);
   for (int i = 0; i < b.lanes; ++i) {
-    PathState<float>& ps = *b.st[i];
-    ps.L = {L.x[i], L.y[i], L.z[i]};
+    std::memcpy(reinterpret_cast<float*>(b.st[i]), &ra[i], sizeof(F8));
+    std::memcpy(reinterpret_cast<float*>(b.st[i]) + 8, &rb[i], sizeof(F8));
     b.wants_shadow[i] = shadow[i] != 0;
+    b.cont[i] = cont[i] != 0;
     if (shadow[i]) {
       ShadowQuery<float>& q = *b.shadow[i];
       q.ray = {{origin.x[i], origin.y[i], origin.z[i]}, {shadow_d.x[i], shadow_d.y[i], shadow_d.z[i]}};
       q.contribution = {contribution.x[i], contribution.y[i], contribution.z[i]};
     }
-    b.cont[i] = cont[i] != 0;
-    if (cont[i]) {
-      ps.ray = {{origin.x[i], origin.y[i], origin.z[i]}, {wi_next.x[i], wi_next.y[i], wi_next.z[i]}};
-      ps.beta = {beta_next.x[i], beta_next.y[i], beta_next.z[i]};
-      ps.bsdf_pdf = pdf[i];
-      ps.depth = vertex[i];
-    }
   }
 }
 
-}  // namespace pb::cpu
+}  // namespace pb::cpu::PB_SIMD_NS

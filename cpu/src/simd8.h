@@ -1,4 +1,4 @@
-#pragma once
+// (No include guard: included once per instruction set, see shade_x8.h.)
 // Eight float lanes for the CPU wavefront's batched shading (shade_x8.h), written with
 // GCC's vector extensions: AVX registers where the build has them, pairs of SSE
 // registers otherwise. Every operation here is the lane-wise twin of the scalar one the
@@ -10,8 +10,9 @@
 #include <cstring>
 
 #include "pathbench/common/math.h"
+#include "pathbench/common/ray_offset.h"
 
-namespace pb::cpu::simd {
+namespace pb::cpu::PB_SIMD_NS {
 
 constexpr int kLanes = 8;
 typedef float F8 __attribute__((vector_size(32)));
@@ -81,6 +82,33 @@ inline F8 power_heuristic(F8 pdf_a, F8 pdf_b) {
   return select(a > 0.0f, a / (a + b), splat(0.0f));
 }
 
+// 8x8 transpose: row i of `r` becomes lane i of every output (the usual unpack /
+// shuffle / 128-bit permute sequence). Its own inverse: it also turns lanes back into rows.
+inline void transpose8(F8 r[8]) {
+#define PB_SHUF(a, b, ...) __builtin_shufflevector(a, b, __VA_ARGS__)
+  F8 t[8], u[8];
+  for (int i = 0; i < 8; i += 2) {
+    t[i] = PB_SHUF(r[i], r[i + 1], 0, 8, 1, 9, 4, 12, 5, 13);      // unpacklo
+    t[i + 1] = PB_SHUF(r[i], r[i + 1], 2, 10, 3, 11, 6, 14, 7, 15);  // unpackhi
+  }
+  for (int i = 0; i < 8; i += 4)
+    for (int j = 0; j < 2; ++j) {
+      u[i + 2 * j] = PB_SHUF(t[i + j], t[i + j + 2], 0, 1, 8, 9, 4, 5, 12, 13);
+      u[i + 2 * j + 1] = PB_SHUF(t[i + j], t[i + j + 2], 2, 3, 10, 11, 6, 7, 14, 15);
+    }
+  for (int j = 0; j < 4; ++j) {
+    r[j] = PB_SHUF(u[j], u[j + 4], 0, 1, 2, 3, 8, 9, 10, 11);
+    r[j + 4] = PB_SHUF(u[j], u[j + 4], 4, 5, 6, 7, 12, 13, 14, 15);
+  }
+#undef PB_SHUF
+}
+
+// Lanes from eight 32-byte records (rows) and back.
+inline void load_rows(const void* const rows[8], int offset_floats, F8 out[8]) {
+  for (int i = 0; i < 8; ++i) std::memcpy(&out[i], static_cast<const float*>(rows[i]) + offset_floats, sizeof(F8));
+  transpose8(out);
+}
+
 inline F8 mean3(V3 v) { return (v.x + v.y + v.z) * float(1.0 / 3.0); }
 
-}  // namespace pb::cpu::simd
+}  // namespace pb::cpu::PB_SIMD_NS
