@@ -43,7 +43,6 @@ namespace pb::cpu::PB_SIMD_NS {
   const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
   V3 v0, v1, v2, albedo, Le;
   V3 l0, l1, l2, le_light;  // the chosen emitter triangle and its emission
-  F8 u0, u1, u_pick, u3;
   I8 emits, scatters;
 
   // The paths' states, one lane each (PathState<float> is two 8-float rows).
@@ -60,6 +59,11 @@ namespace pb::cpu::PB_SIMD_NS {
   const I8 pixel = bits(rb[5]), sample = bits(rb[6]), depth = bits(rb[7]);
   const I8 vertex = depth + 1;
   const I8 mis_e = c.sampling == Sampling::Nee ? (depth > 0) : I8{};
+  // The vertex's four uniforms, drawn for every lane (used only where the lane scatters).
+  F8 ub[4];
+  rng_draw(U8(pixel), c.seed, U8(sample), U8(vertex), kRngVertex, ub);
+  const F8 u0 = ub[0], u1 = ub[1], u3 = ub[3];
+  F8 u_pick = ub[2];
 
   // Per lane: the hit triangle and its material, which lanes scatter, their random
   // numbers and emitter choice.
@@ -75,13 +79,12 @@ namespace pb::cpu::PB_SIMD_NS {
     emits[i] = is_zero(m.emission) ? 0 : -1;
     const bool at_budget = c.max_bounces >= 0 && uint32_t(depth[i]) >= uint32_t(c.max_bounces);
     scatters[i] = (!at_budget && !is_zero(m.albedo)) ? -1 : 0;
-    Uniform4 ub{{0.0f, 0.0f, 0.0f, 0.0f}};
-    if (scatters[i]) ub = RngStream{uint32_t(pixel[i]), c.seed}.draw(uint32_t(sample[i]), uint32_t(vertex[i]), kRngVertex);
-    u0[i] = ub.v[0]; u1[i] = ub.v[1]; u3[i] = ub.v[3];
-    float up = ub.v[2];
     uint32_t light = b.prim[i];  // any valid triangle where no emitter is chosen
-    if (nee && scatters[i]) light = s.emitters[pick_emitter(s, up)];
-    u_pick[i] = up;
+    if (nee && scatters[i]) {
+      float up = u_pick[i];
+      light = s.emitters[pick_emitter(s, up)];
+      u_pick[i] = up;
+    }
     const Triangle lt = s.triangles[light];
     const Vec3f la = s.positions[lt.v[0]], lb = s.positions[lt.v[1]], lc = s.positions[lt.v[2]];
     l0.x[i] = la.x; l0.y[i] = la.y; l0.z[i] = la.z;

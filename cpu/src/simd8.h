@@ -1,7 +1,7 @@
 // (No include guard: included once per instruction set, see shade_x8.h.)
 // Eight float lanes for the CPU wavefront's batched shading (shade_x8.h), written with
-// GCC's vector extensions: AVX registers where the build has them, pairs of SSE
-// registers otherwise. Every operation here is the lane-wise twin of the scalar one the
+// GCC's vector extensions and AVX2 intrinsics: compiled only under
+// `#pragma GCC target("avx2")` (render_wavefront.cpp), used only on CPUs that have it. Every operation here is the lane-wise twin of the scalar one the
 // path step uses (IEEE +, -, *, /, sqrt, compare-and-select; no FMA, -ffp-contract=off),
 // so a lane computes bit for bit what the scalar path step computes for that path.
 #include <immintrin.h>
@@ -17,6 +17,7 @@ namespace pb::cpu::PB_SIMD_NS {
 constexpr int kLanes = 8;
 typedef float F8 __attribute__((vector_size(32)));
 typedef int32_t I8 __attribute__((vector_size(32)));  // masks: -1 (true) or 0
+typedef uint32_t U8 __attribute__((vector_size(32)));
 using V3 = Vec3<F8>;                                    // math.h's +, -, *, dot, cross work lane-wise
 
 inline F8 splat(float x) { return F8{} + x; }
@@ -35,18 +36,7 @@ inline bool any(I8 m) {
   return false;
 }
 
-inline F8 sqrt(F8 a) {
-#if defined(__AVX__)
-  return F8(_mm256_sqrt_ps(__m256(a)));
-#else
-  __m128 h[2];
-  std::memcpy(h, &a, sizeof a);
-  h[0] = _mm_sqrt_ps(h[0]);
-  h[1] = _mm_sqrt_ps(h[1]);
-  std::memcpy(&a, h, sizeof a);
-  return a;
-#endif
-}
+inline F8 sqrt(F8 a) { return F8(_mm256_sqrt_ps(__m256(a))); }
 inline F8 abs(F8 a) { return from_bits(bits(a) & 0x7fffffff); }
 inline F8 copysign(F8 mag, F8 sign) { return from_bits((bits(mag) & 0x7fffffff) | (bits(sign) & int32_t(0x80000000u))); }
 
@@ -107,6 +97,37 @@ inline void transpose8(F8 r[8]) {
 inline void load_rows(const void* const rows[8], int offset_floats, F8 out[8]) {
   for (int i = 0; i < 8; ++i) std::memcpy(&out[i], static_cast<const float*>(rows[i]) + offset_floats, sizeof(F8));
   transpose8(out);
+}
+
+// Random123's mulhilo32 by a constant, eight lanes: lo and hi words of a * m.
+inline void mulhilo(U8 a, uint32_t m, U8& lo, U8& hi) {
+  const __m256i mv = _mm256_set1_epi32(int32_t(m));
+  const __m256i even = _mm256_mul_epu32(__m256i(a), mv);                          // lanes 0, 2, 4, 6
+  const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(__m256i(a), 32), mv);  // lanes 1, 3, 5, 7
+  lo = U8(_mm256_blend_epi32(even, _mm256_slli_epi64(odd, 32), 0xAA));
+  hi = U8(_mm256_blend_epi32(_mm256_srli_epi64(even, 32), odd, 0xAA));
+}
+
+// RngStream::draw (rng.h) for eight lanes: Philox4x32-10 as Random123 computes it,
+// then u32_to_unit_float.
+inline void rng_draw(U8 pixel, uint64_t seed, U8 sample, U8 bounce, uint32_t group, F8 u[4]) {
+  U8 c0 = sample, c1 = bounce, c2 = U8{} + group, c3 = U8{} + uint32_t(seed >> 32);
+  U8 k0 = pixel, k1 = U8{} + uint32_t(seed);
+  for (int r = 0; r < 10; ++r) {
+    if (r > 0) {
+      k0 += 0x9E3779B9u;  // PHILOX_W32_0
+      k1 += 0xBB67AE85u;  // PHILOX_W32_1
+    }
+    U8 lo0, hi0, lo1, hi1;
+    mulhilo(c0, 0xD2511F53u, lo0, hi0);  // PHILOX_M4x32_0
+    mulhilo(c2, 0xCD9E8D57u, lo1, hi1);  // PHILOX_M4x32_1
+    c0 = hi1 ^ c1 ^ k0;
+    c1 = lo1;
+    c2 = hi0 ^ c3 ^ k1;
+    c3 = lo0;
+  }
+  const U8 c[4] = {c0, c1, c2, c3};
+  for (int j = 0; j < 4; ++j) u[j] = __builtin_convertvector(I8(c[j] >> 8), F8) * (1.0f / 16777216.0f);
 }
 
 inline F8 mean3(V3 v) { return (v.x + v.y + v.z) * float(1.0 / 3.0); }
