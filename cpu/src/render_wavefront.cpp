@@ -12,11 +12,13 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
 #include "embree_rays.h"
 #include "pathbench/common/path.h"
+#include "shade_batch.h"
 #include "strategies.h"
 
 // The batched shading (shade_x8.h), compiled for AVX2 whatever the build's baseline;
@@ -143,7 +145,7 @@ template <class T> void stage_intersect(const TraceJob& job, PoolSlice<T>& pool,
 
 // Diffuse-only scenes in float (the paper's case) on AVX2 CPUs: eight paths at a time
 // (shade_x8.h), bit-identical to the scalar path step below.
-PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, const ShadeTable& table, PoolSlice<float>& pool, Local& local) {
   pool.next_live.clear();
   Shade8 batch;
   auto flush = [&] {
@@ -152,7 +154,7 @@ PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, 
       batch.shadow[i] = batch.shadow[0];
       batch.prim[i] = batch.prim[0];
     }
-    avx2::shade_diffuse_x8(job.scene, job.config, batch);
+    avx2::shade_diffuse_x8(job.scene, job.config, table, batch);
     for (int i = 0; i < batch.lanes; ++i) {
       const uint32_t slot = uint32_t(batch.st[i] - pool.state.data());
       if (batch.wants_shadow[i]) {
@@ -178,12 +180,12 @@ PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, PoolSlice<float>& pool, 
   std::swap(pool.live, pool.next_live);
 }
 
+// `table`: non-null where the batched shading runs (batched_shading_table).
 template <class T, uint32_t Kinds>
-PB_CPU_FLATTEN void stage_shade(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const ShadeTable* table, PoolSlice<T>& pool, Local& local) {
   if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    if (avx2) {
-      stage_shade_x8(job, pool, local);
+    if (table) {
+      stage_shade_x8(job, *table, pool, local);
       return;
     }
   }
@@ -236,12 +238,21 @@ template <class T> void stage_accumulate(const TraceJob& job, PoolSlice<T>& pool
   pool.done.clear();
 }
 
+// The batched shading runs for diffuse-only float renders on AVX2 CPUs, in scenes small
+// enough for its per-triangle table.
+template <class T, uint32_t Kinds> std::unique_ptr<ShadeTable> batched_shading_table(const SceneView& s) {
+  if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly)
+    if (__builtin_cpu_supports("avx2") && ShadeTable::fits(s)) return std::make_unique<ShadeTable>(s);
+  return nullptr;
+}
+
 // The stages above, in scalar type T, compiled for the material kinds `Kinds` (features.h).
 template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   const uint32_t pixels = job.config.width * job.config.height;
   SampleSource source(uint64_t(pixels) * job.spp, pixels);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(kPacket, (paths_in_flight + slices - 1) / slices);
+  const std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene);
   tbb::combinable<Local> locals;
   tbb::parallel_for(0, slices, [&](int) {
     Local& local = locals.local();
@@ -253,7 +264,7 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
       if (pool.live.empty()) break;
       stage_final_vertex<T, Kinds>(job, pool, local);
       stage_intersect(job, pool, ctx, local);
-      stage_shade<T, Kinds>(job, pool, local);
+      stage_shade<T, Kinds>(job, table.get(), pool, local);
       stage_shadow(job, pool, ctx);
       stage_accumulate(job, pool, local);
     }

@@ -16,35 +16,17 @@
 #include <cstdint>
 
 #include "pathbench/common/path.h"
+#include "shade_batch.h"
 #include "simd8.h"
 
-#ifndef PB_CPU_SHADE8_DEFINED
-#define PB_CPU_SHADE8_DEFINED
-namespace pb::cpu {
-constexpr int kShadeLanes = 8;
-// One batch: eight paths that hit a triangle, and what shading them asks for next.
-struct Shade8 {
-  PathState<float>* st[kShadeLanes];
-  ShadowQuery<float>* shadow[kShadeLanes];
-  uint32_t prim[kShadeLanes];  // hit triangle of each lane
-  int lanes;                   // lanes in use; the rest repeat lane 0 and write nothing
-  bool wants_shadow[kShadeLanes];
-  bool cont[kShadeLanes];      // PathEvent::Continue
-};
-}  // namespace pb::cpu::PB_SIMD_NS
-#endif
 
 namespace pb::cpu::PB_SIMD_NS {
 
 // path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), *shadow[i], wants_shadow[i])
-// for every lane i.
-[[gnu::noinline, gnu::flatten]] inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, Shade8& b) {
+// for every lane i; `table` is built from `s`.
+[[gnu::noinline, gnu::flatten]] inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, const ShadeTable& table, Shade8& b) {
   constexpr int N = kLanes;
   const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
-  V3 v0, v1, v2, albedo, Le;
-  V3 l0, l1, l2, le_light;  // the chosen emitter triangle and its emission
-  I8 emits, scatters;
-
   // The paths' states, one lane each (PathState<float> is two 8-float rows).
   static_assert(sizeof(PathState<float>) == 2 * sizeof(F8), "PathState<float>: 16 floats, as the rows below");
   const void* rows[N];
@@ -65,37 +47,40 @@ namespace pb::cpu::PB_SIMD_NS {
   const F8 u0 = ub[0], u1 = ub[1], u3 = ub[3];
   F8 u_pick = ub[2];
 
-  // Per lane: the hit triangle and its material, which lanes scatter, their random
-  // numbers and emitter choice.
+  // The hit triangles: geometry and material (ShadeTable rows).
+  const void* tri_rows[N];
+  for (int i = 0; i < N; ++i) tri_rows[i] = table.row(b.prim[i]);
+  F8 ta[N], tb[N], tc[N];
+  load_rows(tri_rows, 0, ta);
+  load_rows(tri_rows, 8, tb);
+  load_rows(tri_rows, 16, tc);
+  const V3 v0{ta[0], ta[1], ta[2]}, e1{ta[3], ta[4], ta[5]}, e2{ta[6], ta[7], tb[0]};
+  const V3 ng{tb[1], tb[2], tb[3]}, albedo{tb[4], tb[5], tb[6]};
+  const I8 emits = bits(tb[7]);
+  const V3 Le{tc[0], tc[1], tc[2]};
+  const I8 at_budget = c.max_bounces >= 0 ? (depth >= c.max_bounces) : I8{};  // depth is small: signed compare is exact
+  const I8 scatters = bits(tc[3]) & ~at_budget;
+
+  // Per lane: the emitter light sampling picks (scalar pick_emitter), then its rows.
+  uint32_t light[N];
   for (int i = 0; i < N; ++i) {
-    const Triangle tri = s.triangles[b.prim[i]];
-    const Vec3f a = s.positions[tri.v[0]], bb = s.positions[tri.v[1]], cc = s.positions[tri.v[2]];
-    v0.x[i] = a.x; v0.y[i] = a.y; v0.z[i] = a.z;
-    v1.x[i] = bb.x; v1.y[i] = bb.y; v1.z[i] = bb.z;
-    v2.x[i] = cc.x; v2.y[i] = cc.y; v2.z[i] = cc.z;
-    const Material& m = s.material_of(b.prim[i]);
-    Le.x[i] = m.emission.x; Le.y[i] = m.emission.y; Le.z[i] = m.emission.z;
-    albedo.x[i] = m.albedo.x; albedo.y[i] = m.albedo.y; albedo.z[i] = m.albedo.z;
-    emits[i] = is_zero(m.emission) ? 0 : -1;
-    const bool at_budget = c.max_bounces >= 0 && uint32_t(depth[i]) >= uint32_t(c.max_bounces);
-    scatters[i] = (!at_budget && !is_zero(m.albedo)) ? -1 : 0;
-    uint32_t light = b.prim[i];  // any valid triangle where no emitter is chosen
+    light[i] = b.prim[i];  // any valid triangle where no emitter is chosen
     if (nee && scatters[i]) {
       float up = u_pick[i];
-      light = s.emitters[pick_emitter(s, up)];
+      light[i] = s.emitters[pick_emitter(s, up)];
       u_pick[i] = up;
     }
-    const Triangle lt = s.triangles[light];
-    const Vec3f la = s.positions[lt.v[0]], lb = s.positions[lt.v[1]], lc = s.positions[lt.v[2]];
-    l0.x[i] = la.x; l0.y[i] = la.y; l0.z[i] = la.z;
-    l1.x[i] = lb.x; l1.y[i] = lb.y; l1.z[i] = lb.z;
-    l2.x[i] = lc.x; l2.y[i] = lc.y; l2.z[i] = lc.z;
-    const Vec3f lle = s.material_of(light).emission;
-    le_light.x[i] = lle.x; le_light.y[i] = lle.y; le_light.z[i] = lle.z;
+    tri_rows[i] = table.row(light[i]);
   }
+  F8 la[N], lb[N], lc[N];
+  load_rows(tri_rows, 0, la);
+  load_rows(tri_rows, 8, lb);
+  load_rows(tri_rows, 16, lc);
+  const V3 l0{la[0], la[1], la[2]}, le1{la[3], la[4], la[5]}, le2{la[6], la[7], lb[0]};
+  const V3 nl{lb[1], lb[2], lb[3]};
+  const V3 le_light{lc[0], lc[1], lc[2]};
 
   // surface_hit (surface_hit.h).
-  const V3 e1 = v1 - v0, e2 = v2 - v0;
   const V3 pv = cross(d, e2);
   const F8 inv_det = 1.0f / dot(e1, pv);
   const V3 tv = o - v0;
@@ -106,7 +91,6 @@ namespace pb::cpu::PB_SIMD_NS {
   b1 = vmin(vmax(b1, F8{}), splat(1.0f));
   b2 = vmin(vmax(b2, F8{}), 1.0f - b1);
   const V3 p = v0 + e1 * b1 + e2 * b2;
-  const V3 ng = normalize(cross(e1, e2));
 
   // 1. Emission, MIS-weighted after the first vertex (emitted_radiance).
   const F8 cos_o = -dot(ng, d);
@@ -123,11 +107,9 @@ namespace pb::cpu::PB_SIMD_NS {
   I8 shadow = I8{};
   V3 contribution, shadow_d;
   if (nee) {
-    const V3 le1 = l1 - l0, le2 = l2 - l0;
     const F8 su = sqrt(u_pick);
     const F8 tb1 = 1.0f - su, tb2 = u3 * su;
     const V3 y = l0 + le1 * tb1 + le2 * tb2;
-    const V3 nl = normalize(cross(le1, le2));
     V3 wi = y - p;
     const F8 dist2 = dot(wi, wi);
     wi = wi / sqrt(dist2);
