@@ -107,8 +107,34 @@ template <class T> PB_CPU_FLATTEN void stage_generate(const TraceJob& job, Sampl
 
 // Paths whose next hit could only add emitted light leave the live list here: their
 // occlusion test (if they face an emitter) joins the shadow stage, and they are done.
+// With `batched` (float, AVX2: see batched_shading_table) eight paths at a time are first
+// screened for an emitter along their ray (shade_x8.h); the scalar query runs only for
+// the lanes that may have one, and gives every path what it would have given it anyway.
 template <class T, uint32_t Kinds>
-PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, bool batched, PoolSlice<T>& pool, Local& local) {
+  auto final_query = [&](uint32_t slot) {
+    const PathState<T>& st = pool.state[slot];
+    if (path_final_query<Kinds>(job.scene, job.config, st, pool.shadow[slot])) {
+      pool.shadowed.push_back(slot);
+      count_ray(local.rays, st.depth, &RayCounts::shadow);
+    }
+    pool.done.push_back(slot);
+  };
+  PathState<float>* lanes[kShadeLanes];
+  uint32_t lane_slots[kShadeLanes];
+  int n = 0;
+  auto flush = [&] {
+    if constexpr (std::is_same_v<T, float>) {
+      for (int i = n; i < kShadeLanes; ++i) lanes[i] = lanes[0];
+      bool candidate[kShadeLanes];
+      avx2::final_vertex_candidates_x8(job.scene, lanes, candidate);
+      for (int i = 0; i < n; ++i) {
+        if (candidate[i]) final_query(lane_slots[i]);
+        else pool.done.push_back(lane_slots[i]);
+      }
+    }
+    n = 0;
+  };
   size_t keep = 0;
   for (uint32_t slot : pool.live) {
     const PathState<T>& st = pool.state[slot];
@@ -116,12 +142,17 @@ PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, PoolSlice<T>& pool, 
       pool.live[keep++] = slot;
       continue;
     }
-    if (path_final_query<Kinds>(job.scene, job.config, st, pool.shadow[slot])) {
-      pool.shadowed.push_back(slot);
-      count_ray(local.rays, st.depth, &RayCounts::shadow);
+    if constexpr (std::is_same_v<T, float>) {
+      if (batched) {
+        lanes[n] = &pool.state[slot];
+        lane_slots[n] = slot;
+        if (++n == kShadeLanes) flush();
+        continue;
+      }
     }
-    pool.done.push_back(slot);
+    final_query(slot);
   }
+  if (n > 0) flush();
   pool.live.resize(keep);
 }
 
@@ -262,7 +293,7 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
     for (;;) {
       stage_generate(job, source, pool);
       if (pool.live.empty()) break;
-      stage_final_vertex<T, Kinds>(job, pool, local);
+      stage_final_vertex<T, Kinds>(job, table != nullptr, pool, local);
       stage_intersect(job, pool, ctx, local);
       stage_shade<T, Kinds>(job, table.get(), pool, local);
       stage_shadow(job, pool, ctx);

@@ -183,3 +183,61 @@ namespace pb::cpu::PB_SIMD_NS {
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS
+
+namespace pb::cpu::PB_SIMD_NS {
+
+// The last vertex of a bounded path (path_final_query, path.h), eight paths at once:
+// whether any emitter lies along each lane's ray. The scalar query then runs only for
+// the lanes marked here (false for most rays: the emitters are small), so this need
+// only never say "no" where the scalar test would find a hit. It computes
+// intersect_watertight's float arithmetic lane-wise with t_max = FLT_MAX for every
+// emitter (the scalar loop's bound until its first hit), and marks any lane whose edge
+// functions come out exactly 0 (where watertight.h falls back to double).
+// Keep in step with common/include/pathbench/common/watertight.h.
+[[gnu::noinline]] inline void final_vertex_candidates_x8(const SceneView& s, PathState<float>* const st[kShadeLanes],
+                                                        bool candidate[kShadeLanes]) {
+  constexpr int N = kLanes;
+  const void* rows[N];
+  for (int i = 0; i < N; ++i) rows[i] = st[i];
+  F8 ra[N];
+  load_rows(rows, 0, ra);
+  const V3 o{ra[0], ra[1], ra[2]}, d{ra[3], ra[4], ra[5]};
+  // make_watertight_ray: the dominant axis kz, then kx, ky (swapped where d[kz] < 0).
+  const F8 ax = abs(d.x), ay = abs(d.y), az = abs(d.z);
+  const I8 z_is_x = (ax > ay) & (ax > az), z_is_y = ~z_is_x & (ay > az), z_is_z = ~z_is_x & ~z_is_y;
+  const F8 dz = select(z_is_x, d.x, select(z_is_y, d.y, d.z));
+  // kx = kz + 1, ky = kz + 2 (mod 3); a negative dz swaps them.
+  auto axis_after = [&](const V3& v, int step) {  // v[(kz + step) % 3]
+    const F8 next_of_x = step == 1 ? v.y : v.z, next_of_y = step == 1 ? v.z : v.x, next_of_z = step == 1 ? v.x : v.y;
+    return select(z_is_x, next_of_x, select(z_is_y, next_of_y, next_of_z));
+  };
+  const I8 swap = dz < 0.0f;
+  auto axis_x = [&](const V3& v) { return select(swap, axis_after(v, 2), axis_after(v, 1)); };
+  auto axis_y = [&](const V3& v) { return select(swap, axis_after(v, 1), axis_after(v, 2)); };
+  auto axis_z = [&](const V3& v) { return select(z_is_x, v.x, select(z_is_y, v.y, v.z)); };
+  (void)z_is_z;
+  const F8 sx = axis_x(d) / dz, sy = axis_y(d) / dz, sz = 1.0f / dz;
+  const F8 t_max = splat(3.402823466e38f);
+  I8 maybe = I8{};
+  for (uint32_t k = 0; k < s.num_emitters; ++k) {
+    const Triangle tri = s.triangles[s.emitters[k]];
+    auto rel = [&](const Vec3f& p) { return V3{p.x - o.x, p.y - o.y, p.z - o.z}; };
+    const V3 A = rel(s.positions[tri.v[0]]), B = rel(s.positions[tri.v[1]]), C = rel(s.positions[tri.v[2]]);
+    const F8 Az = axis_z(A), Bz = axis_z(B), Cz = axis_z(C);
+    const F8 Ax = axis_x(A) - sx * Az, Ay = axis_y(A) - sy * Az;
+    const F8 Bx = axis_x(B) - sx * Bz, By = axis_y(B) - sy * Bz;
+    const F8 Cx = axis_x(C) - sx * Cz, Cy = axis_y(C) - sy * Cz;
+    const F8 U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
+    const I8 on_edge = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
+    const I8 outside = ((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f));
+    const F8 det = U + V + W;
+    const F8 T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
+    const I8 in_range = (det > 0.0f) ? ((T > 0.0f) & (T < t_max * det)) : ((T < 0.0f) & (T > t_max * det));
+    const F8 t = T / det;
+    const I8 hit = ~outside & (det != 0.0f) & in_range & (t > 0.0f) & (t < t_max);
+    maybe |= on_edge | hit;
+  }
+  for (int i = 0; i < N; ++i) candidate[i] = maybe[i] != 0;
+}
+
+}  // namespace pb::cpu::PB_SIMD_NS
