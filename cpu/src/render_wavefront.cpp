@@ -93,11 +93,37 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-template <class T> PB_CPU_FLATTEN void stage_generate(const TraceJob& job, SampleSource& src, PoolSlice<T>& pool) {
+// With `batched` (float, AVX2) eight new paths at a time (begin_paths_x8, shade_x8.h).
+template <class T>
+PB_CPU_FLATTEN void stage_generate(const TraceJob& job, bool batched, SampleSource& src, PoolSlice<T>& pool) {
   uint64_t n = pool.free.size();
   if (n == 0) return;
   const uint64_t start = src.claim(n);
-  for (uint64_t i = 0; i < n; ++i) {
+  uint64_t i = 0;
+  if constexpr (std::is_same_v<T, float>) {
+    if (batched) {
+      for (; i < n; i += kShadeLanes) {
+        const int lanes = int(std::min<uint64_t>(kShadeLanes, n - i));
+        uint32_t pixel[kShadeLanes], sample[kShadeLanes];
+        PathState<float>* st[kShadeLanes];
+        for (int l = 0; l < kShadeLanes; ++l) {
+          const uint64_t g = start + i + uint64_t(l < lanes ? l : 0);
+          pixel[l] = src.pixel_of(g);
+          sample[l] = src.sample_of(g);
+          if (l < lanes) {
+            st[l] = &pool.state[pool.free.back()];
+            pool.live.push_back(pool.free.back());
+            pool.free.pop_back();
+          } else {
+            st[l] = st[0];
+          }
+        }
+        avx2::begin_paths_x8(job.scene, job.config, pixel, sample, st, lanes);
+      }
+      return;
+    }
+  }
+  for (; i < n; ++i) {
     const uint32_t slot = pool.free.back();
     pool.free.pop_back();
     path_begin(job.scene, job.config, src.pixel_of(start + i), src.sample_of(start + i), pool.state[slot]);
@@ -291,7 +317,7 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
-      stage_generate(job, source, pool);
+      stage_generate(job, table != nullptr, source, pool);
       if (pool.live.empty()) break;
       stage_final_vertex<T, Kinds>(job, table != nullptr, pool, local);
       stage_intersect(job, pool, ctx, local);

@@ -241,3 +241,45 @@ namespace pb::cpu::PB_SIMD_NS {
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS
+
+namespace pb::cpu::PB_SIMD_NS {
+
+// path_begin (path.h) for eight new paths: camera_ray (camera.h) lane-wise in its order
+// of operations, the camera's random numbers from rng_draw.
+[[gnu::noinline]] inline void begin_paths_x8(const SceneView& s, const PathConfig& c, const uint32_t pixel[kShadeLanes],
+                                            const uint32_t sample[kShadeLanes], PathState<float>* const st[kShadeLanes],
+                                            int lanes) {
+  constexpr int N = kLanes;
+  U8 pix, smp;
+  I8 px, py;
+  for (int i = 0; i < N; ++i) {
+    pix[i] = pixel[i];
+    smp[i] = sample[i];
+    px[i] = int32_t(pixel[i] % c.width);
+    py[i] = int32_t(pixel[i] / c.width);
+  }
+  F8 u[4];
+  rng_draw(pix, c.seed, smp, U8{}, kRngCamera, u);
+  const Camera& cam = s.camera;
+  const float w = float(c.width), h = float(c.height);
+  const F8 sx = (__builtin_convertvector(px, F8) + u[0]) / w * 2.0f - 1.0f;
+  const F8 sy = 1.0f - (__builtin_convertvector(py, F8) + u[1]) / h * 2.0f;
+  const float tan_y = cam.tan_half_fov_y;
+  const float tan_x = tan_y * w / h;
+  auto bc = [](const Vec3f& v) { return V3{splat(v.x), splat(v.y), splat(v.z)}; };
+  const V3 d = normalize(bc(cam.forward) + bc(cam.right) * (sx * tan_x) + bc(cam.up) * (sy * tan_y));
+  F8 ra[N], rb[N];
+  ra[0] = splat(cam.position.x); ra[1] = splat(cam.position.y); ra[2] = splat(cam.position.z);
+  ra[3] = d.x; ra[4] = d.y; ra[5] = d.z;
+  ra[6] = ra[7] = rb[0] = splat(1.0f);             // beta
+  rb[1] = rb[2] = rb[3] = rb[4] = F8{};            // L, bsdf_pdf
+  rb[5] = from_bits(I8(pix)); rb[6] = from_bits(I8(smp)); rb[7] = F8{};  // pixel, sample, depth 0
+  transpose8(ra);
+  transpose8(rb);
+  for (int i = 0; i < lanes; ++i) {
+    std::memcpy(reinterpret_cast<float*>(st[i]), &ra[i], sizeof(F8));
+    std::memcpy(reinterpret_cast<float*>(st[i]) + 8, &rb[i], sizeof(F8));
+  }
+}
+
+}  // namespace pb::cpu::PB_SIMD_NS
