@@ -167,11 +167,10 @@ namespace pb::cpu::PB_SIMD_NS {
   rb[1] = L.x; rb[2] = L.y; rb[3] = L.z;
   rb[4] = select(cont, pdf, rb[4]);
   rb[7] = from_bits(cont ? vertex : depth);
-  transpose8(ra);
-  transpose8(rb);
+  void* const out_rows[N] = {b.st[0], b.st[1], b.st[2], b.st[3], b.st[4], b.st[5], b.st[6], b.st[7]};
+  store_rows(ra, out_rows, 0, b.lanes);
+  store_rows(rb, out_rows, 8, b.lanes);
   for (int i = 0; i < b.lanes; ++i) {
-    std::memcpy(reinterpret_cast<float*>(b.st[i]), &ra[i], sizeof(F8));
-    std::memcpy(reinterpret_cast<float*>(b.st[i]) + 8, &rb[i], sizeof(F8));
     b.wants_shadow[i] = shadow[i] != 0;
     b.cont[i] = cont[i] != 0;
     if (shadow[i]) {
@@ -274,12 +273,9 @@ namespace pb::cpu::PB_SIMD_NS {
   ra[6] = ra[7] = rb[0] = splat(1.0f);             // beta
   rb[1] = rb[2] = rb[3] = rb[4] = F8{};            // L, bsdf_pdf
   rb[5] = from_bits(I8(pix)); rb[6] = from_bits(I8(smp)); rb[7] = F8{};  // pixel, sample, depth 0
-  transpose8(ra);
-  transpose8(rb);
-  for (int i = 0; i < lanes; ++i) {
-    std::memcpy(reinterpret_cast<float*>(st[i]), &ra[i], sizeof(F8));
-    std::memcpy(reinterpret_cast<float*>(st[i]) + 8, &rb[i], sizeof(F8));
-  }
+  void* const out_rows[N] = {st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]};
+  store_rows(ra, out_rows, 0, lanes);
+  store_rows(rb, out_rows, 8, lanes);
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS

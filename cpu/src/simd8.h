@@ -72,31 +72,46 @@ inline F8 power_heuristic(F8 pdf_a, F8 pdf_b) {
   return select(a > 0.0f, a / (a + b), splat(0.0f));
 }
 
-// 8x8 transpose: row i of `r` becomes lane i of every output (the usual unpack /
-// shuffle / 128-bit permute sequence). Its own inverse: it also turns lanes back into rows.
-inline void transpose8(F8 r[8]) {
-#define PB_SHUF(a, b, ...) __builtin_shufflevector(a, b, __VA_ARGS__)
-  F8 t[8], u[8];
-  for (int i = 0; i < 8; i += 2) {
-    t[i] = PB_SHUF(r[i], r[i + 1], 0, 8, 1, 9, 4, 12, 5, 13);      // unpacklo
-    t[i + 1] = PB_SHUF(r[i], r[i + 1], 2, 10, 3, 11, 6, 14, 7, 15);  // unpackhi
-  }
-  for (int i = 0; i < 8; i += 4)
-    for (int j = 0; j < 2; ++j) {
-      u[i + 2 * j] = PB_SHUF(t[i + j], t[i + j + 2], 0, 1, 8, 9, 4, 5, 12, 13);
-      u[i + 2 * j + 1] = PB_SHUF(t[i + j], t[i + j + 2], 2, 3, 10, 11, 6, 7, 14, 15);
-    }
-  for (int j = 0; j < 4; ++j) {
-    r[j] = PB_SHUF(u[j], u[j + 4], 0, 1, 2, 3, 8, 9, 10, 11);
-    r[j + 4] = PB_SHUF(u[j], u[j + 4], 4, 5, 6, 7, 12, 13, 14, 15);
-  }
-#undef PB_SHUF
+// Eight 8-float records ("rows") to lanes and back: lane i of out[j] is rows[i][j].
+// Each 4x4 block is transposed inside a 128-bit half; the halves come straight from
+// memory (rows i and i + 4 share a register), so the whole load is 16 loads and 16
+// shuffles.
+[[gnu::always_inline]] inline void transpose4_halves(__m256 r0, __m256 r1, __m256 r2, __m256 r3, F8* out) {
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+  out[0] = F8(_mm256_shuffle_ps(t0, t2, 0x44));
+  out[1] = F8(_mm256_shuffle_ps(t0, t2, 0xEE));
+  out[2] = F8(_mm256_shuffle_ps(t1, t3, 0x44));
+  out[3] = F8(_mm256_shuffle_ps(t1, t3, 0xEE));
 }
-
-// Lanes from eight 32-byte records (rows) and back.
-inline void load_rows(const void* const rows[8], int offset_floats, F8 out[8]) {
-  for (int i = 0; i < 8; ++i) std::memcpy(&out[i], static_cast<const float*>(rows[i]) + offset_floats, sizeof(F8));
-  transpose8(out);
+[[gnu::always_inline]] inline __m256 two_halves(const float* lo, const float* hi) {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1);
+}
+[[gnu::always_inline]] inline void load_rows(const void* const rows[8], int offset_floats, F8 out[8]) {
+  const float* p[8];
+  for (int i = 0; i < 8; ++i) p[i] = static_cast<const float*>(rows[i]) + offset_floats;
+  transpose4_halves(two_halves(p[0], p[4]), two_halves(p[1], p[5]), two_halves(p[2], p[6]), two_halves(p[3], p[7]), out);
+  transpose4_halves(two_halves(p[0] + 4, p[4] + 4), two_halves(p[1] + 4, p[5] + 4), two_halves(p[2] + 4, p[6] + 4),
+                    two_halves(p[3] + 4, p[7] + 4), out + 4);
+}
+// The inverse: lane i of in[j] to rows[i][j], for the first `lanes` rows.
+[[gnu::always_inline]] inline void store_rows(const F8 in[8], void* const rows[8], int offset_floats, int lanes) {
+  F8 t[8];
+  transpose4_halves(__m256(in[0]), __m256(in[1]), __m256(in[2]), __m256(in[3]), t);
+  transpose4_halves(__m256(in[4]), __m256(in[5]), __m256(in[6]), __m256(in[7]), t + 4);
+  // t[i] (i < 4): row i, columns 0-3 | row i + 4, columns 0-3; t[i + 4]: the same for columns 4-7.
+  for (int i = 0; i < 4; ++i) {
+    if (i < lanes) {
+      float* q = static_cast<float*>(rows[i]) + offset_floats;
+      _mm_storeu_ps(q, _mm256_castps256_ps128(__m256(t[i])));
+      _mm_storeu_ps(q + 4, _mm256_castps256_ps128(__m256(t[i + 4])));
+    }
+    if (i + 4 < lanes) {
+      float* q = static_cast<float*>(rows[i + 4]) + offset_floats;
+      _mm_storeu_ps(q, _mm256_extractf128_ps(__m256(t[i]), 1));
+      _mm_storeu_ps(q + 4, _mm256_extractf128_ps(__m256(t[i + 4]), 1));
+    }
+  }
 }
 
 // Random123's mulhilo32 by a constant, eight lanes: lo and hi words of a * m.
