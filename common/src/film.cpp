@@ -5,11 +5,6 @@
 
 namespace pb {
 
-namespace {
-// Largest per-pixel sum we allow: 2^62, leaving a factor 2 of headroom.
-constexpr double kMaxSum = 4611686018427387904.0;
-}
-
 Film::Film(uint32_t width, uint32_t height, bool variance) : width_(width), height_(height) {
   sum_.assign(pixels() * 3, 0);
   count_.assign(pixels(), 0);
@@ -25,38 +20,10 @@ double Film::choose_scale(uint64_t spp, float max_emission) {
 
 void Film::begin(uint64_t spp, float max_emission) {
   scale_ = choose_scale(spp, max_emission);
+  limit_ = kMaxSum / 4 / scale_;
   std::fill(sum_.begin(), sum_.end(), 0);
   std::fill(count_.begin(), count_.end(), 0);
   std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
-}
-
-bool Film::acceptable(Vec3f L, double scale) {
-  if (!is_finite(L)) return false;
-  const double limit = kMaxSum / 4 / scale;  // one sample may use at most a quarter of the range
-  return std::fabs(L.x) < limit && std::fabs(L.y) < limit && std::fabs(L.z) < limit;
-}
-
-bool Film::add(uint32_t pixel, Vec3f L) {
-  if (!acceptable(L, scale_)) return false;
-  int64_t* s = &sum_[size_t(pixel) * 3];
-  for (int c = 0; c < 3; ++c) s[c] += quantize_radiance(L[c], scale_);
-  ++count_[pixel];
-  if (!sum_sq_.empty())
-    for (int c = 0; c < 3; ++c) sum_sq_[size_t(pixel) * 3 + c] += double(L[c]) * double(L[c]);
-  return true;
-}
-
-bool Film::add_atomic(uint32_t pixel, Vec3f L) {
-  if (!acceptable(L, scale_)) return false;
-  int64_t* s = &sum_[size_t(pixel) * 3];
-  for (int c = 0; c < 3; ++c)
-    std::atomic_ref<int64_t>(s[c]).fetch_add(quantize_radiance(L[c], scale_), std::memory_order_relaxed);
-  std::atomic_ref<uint32_t>(count_[pixel]).fetch_add(1, std::memory_order_relaxed);
-  if (!sum_sq_.empty())
-    for (int c = 0; c < 3; ++c)
-      std::atomic_ref<double>(sum_sq_[size_t(pixel) * 3 + c]).fetch_add(double(L[c]) * double(L[c]),
-                                                                        std::memory_order_relaxed);
-  return true;
 }
 
 FilmView Film::view() {

@@ -6,6 +6,9 @@
 // double running sum does. The scale is a power of two chosen per render from the
 // scene's brightest emitter and the sample count, so the sum cannot overflow unless
 // the mean pixel value exceeds 1024 x the brightest emission.
+#if !defined(__CUDACC__)
+#include <atomic>
+#endif
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -37,9 +40,12 @@ class Film {
 
   // Sample value -> film; false (and nothing added) when any channel is NaN or
   // infinite, or so large it would overflow: the caller counts it as discarded.
+  // (Inline, below: they run once per sample in the tracers' inner loops.)
   bool add(uint32_t pixel, Vec3f L);         // single writer per pixel
   bool add_atomic(uint32_t pixel, Vec3f L);  // many writers
   static bool acceptable(Vec3f L, double scale);
+  // Largest per-pixel sum (2^62); one sample may use at most a quarter of it.
+  static constexpr double kMaxSum = 4611686018427387904.0;
 
   uint32_t width() const { return width_; }
   uint32_t height() const { return height_; }
@@ -60,11 +66,49 @@ class Film {
   std::vector<double>& raw_sum_sq() { return sum_sq_; }
 
  private:
+  bool accepts(Vec3f L) const {  // acceptable(L, scale_), its limit computed once in begin()
+    return is_finite(L) && std::fabs(L.x) < limit_ && std::fabs(L.y) < limit_ && std::fabs(L.z) < limit_;
+  }
+
   uint32_t width_ = 0, height_ = 0;
   double scale_ = 1;
+  double limit_ = kMaxSum / 4;  // kMaxSum / 4 / scale_
   std::vector<int64_t> sum_;
   std::vector<uint32_t> count_;
   std::vector<double> sum_sq_;
 };
+
+inline bool Film::acceptable(Vec3f L, double scale) {
+  if (!is_finite(L)) return false;
+  const double limit = kMaxSum / 4 / scale;
+  return std::fabs(L.x) < limit && std::fabs(L.y) < limit && std::fabs(L.z) < limit;
+}
+
+// Host only (std::atomic_ref is C++20; nvcc may compile this header as C++17, and the
+// GPU accumulates with atomicAdd of its own).
+#if !defined(__CUDACC__)
+inline bool Film::add(uint32_t pixel, Vec3f L) {
+  if (!accepts(L)) return false;
+  int64_t* s = &sum_[size_t(pixel) * 3];
+  for (int c = 0; c < 3; ++c) s[c] += quantize_radiance(L[c], scale_);
+  ++count_[pixel];
+  if (!sum_sq_.empty())
+    for (int c = 0; c < 3; ++c) sum_sq_[size_t(pixel) * 3 + c] += double(L[c]) * double(L[c]);
+  return true;
+}
+
+inline bool Film::add_atomic(uint32_t pixel, Vec3f L) {
+  if (!accepts(L)) return false;
+  int64_t* s = &sum_[size_t(pixel) * 3];
+  for (int c = 0; c < 3; ++c)
+    std::atomic_ref<int64_t>(s[c]).fetch_add(quantize_radiance(L[c], scale_), std::memory_order_relaxed);
+  std::atomic_ref<uint32_t>(count_[pixel]).fetch_add(1, std::memory_order_relaxed);
+  if (!sum_sq_.empty())
+    for (int c = 0; c < 3; ++c)
+      std::atomic_ref<double>(sum_sq_[size_t(pixel) * 3 + c]).fetch_add(double(L[c]) * double(L[c]),
+                                                                        std::memory_order_relaxed);
+  return true;
+}
+#endif
 
 }  // namespace pb
