@@ -135,12 +135,8 @@ namespace pb::cpu::PB_SIMD_NS {
     z = sqrt(vmax(F8{}, 1.0f - u0));
     pdf = vmax(z, F8{}) * kInvPi<float>;
   }
-  const F8 phi = 2.0f * kPi<float> * u1;
-  F8 cos_phi, sin_phi;
-  for (int i = 0; i < N; ++i) {
-    cos_phi[i] = std::cos(phi[i]);
-    sin_phi[i] = std::sin(phi[i]);
-  }
+  F8 sin_phi, cos_phi;
+  sincos_turns(u1, sin_phi, cos_phi);
   const V3 local{r * cos_phi, r * sin_phi, z};
   I8 cont = scatters & (pdf > 0.0f) & (z > 0.0f);
   V3 beta_next = beta * (albedo * splat(kInvPi<float>) * (z / pdf));

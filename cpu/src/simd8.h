@@ -145,6 +145,23 @@ inline void rng_draw(U8 pixel, uint64_t seed, U8 sample, U8 bounce, uint32_t gro
   for (int j = 0; j < 4; ++j) u[j] = __builtin_convertvector(I8(c[j] >> 8), F8) * (1.0f / 16777216.0f);
 }
 
+// sincos_turns<float> (sampling.h) lane-wise, in its order of operations.
+inline void sincos_turns(F8 u, F8& s, F8& c) {
+  const F8 x = 4.0f * u;
+  const I8 q = __builtin_convertvector(x, I8);
+  const F8 f = x - __builtin_convertvector(q, F8);
+  const I8 upper = f > 0.5f;
+  const F8 g = select(upper, 1.0f - f, f);
+  const F8 y = g * 1.57079632679489662f, y2 = y * y;
+  const F8 sp = y + y * y2 * (-1.66666667e-1f + y2 * (8.33333333e-3f + y2 * (-1.98412698e-4f + y2 * 2.75573192e-6f)));
+  const F8 cp = 1.0f + y2 * (-0.5f + y2 * (4.16666667e-2f + y2 * (-1.38888889e-3f + y2 * (2.48015873e-5f + y2 * -2.75573192e-7f))));
+  const F8 sa = select(upper, cp, sp), ca = select(upper, sp, cp);
+  const I8 odd = (q & 1) != 0, half = (q & 2) != 0;
+  const F8 s1 = select(odd, ca, sa), c1 = select(odd, -sa, ca);
+  s = select(half, -s1, s1);
+  c = select(half, -c1, c1);
+}
+
 inline F8 mean3(V3 v) { return (v.x + v.y + v.z) * float(1.0 / 3.0); }
 
 }  // namespace pb::cpu::PB_SIMD_NS
