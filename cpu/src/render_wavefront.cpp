@@ -182,21 +182,50 @@ PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, bool batched, PoolSl
   pool.live.resize(keep);
 }
 
-template <class T> void stage_intersect(const TraceJob& job, PoolSlice<T>& pool, RTCIntersectContext& ctx, Local& local) {
-  for (uint32_t slot : pool.live) count_ray(local.rays, pool.state[slot].depth, &RayCounts::bounce);
+// Packet fields that stay as set: everything but the ray, tfar and the hit.
+template <class Ray8> void init_packet_constants(Ray8& r) {
+  for (int i = 0; i < kPacket; ++i) {
+    r.tnear[i] = 0.0f;
+    r.time[i] = 0.0f;
+    r.mask[i] = 0xFFFFFFFFu;
+    r.id[i] = 0;
+    r.flags[i] = 0;
+  }
+}
+
+// With `batched` (float, AVX2) each packet's rays come from the states by one transpose
+// (rays_to_packet_x8) instead of lane by lane.
+template <class T>
+void stage_intersect(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCIntersectContext& ctx, Local& local) {
   alignas(64) RTCRayHitNt<kPacket> packet;
   alignas(64) int valid[kPacket];
+  init_packet_constants(packet.ray);
   for (size_t base = 0; base < pool.live.size(); base += kPacket) {
     const int n = int(std::min<size_t>(kPacket, pool.live.size() - base));
+    const uint32_t* slots = &pool.live[base];
+    bool filled = false;
+    if constexpr (std::is_same_v<T, float>) {
+      if (batched) {
+        const void* rows[kPacket];
+        for (int i = 0; i < kPacket; ++i) rows[i] = &pool.state[slots[i < n ? i : 0]];
+        RTCRayNt<kPacket>& r = packet.ray;
+        avx2::rays_to_packet_x8(rows, r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z);
+        filled = true;
+      }
+    }
     for (int i = 0; i < kPacket; ++i) {
       valid[i] = i < n ? -1 : 0;
-      if (i < n) set_lane(packet.ray, i, pool.state[pool.live[base + i]].ray, kInfinity);
+      if (i < n) {
+        const PathState<T>& st = pool.state[slots[i]];
+        count_ray(local.rays, st.depth, &RayCounts::bounce);
+        if (!filled) set_lane(packet.ray, i, st.ray, kInfinity);
+      }
+      packet.ray.tfar[i] = kInfinity;
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
     }
     intersect_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i)
-      pool.prim[pool.live[base + i]] =
-          packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : packet.hit.primID[i];
+      pool.prim[slots[i]] = packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : packet.hit.primID[i];
   }
 }
 
@@ -266,18 +295,30 @@ PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const ShadeTable* table, Po
   std::swap(pool.live, pool.next_live);
 }
 
-template <class T> void stage_shadow(const TraceJob& job, PoolSlice<T>& pool, RTCIntersectContext& ctx) {
+template <class T> void stage_shadow(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCIntersectContext& ctx) {
   alignas(64) RTCRayNt<kPacket> packet;
   alignas(64) int valid[kPacket];
+  init_packet_constants(packet);
   for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
     const int n = int(std::min<size_t>(kPacket, pool.shadowed.size() - base));
+    const uint32_t* slots = &pool.shadowed[base];
+    bool filled = false;
+    if constexpr (std::is_same_v<T, float>) {
+      if (batched) {
+        const void* rows[kPacket];
+        for (int i = 0; i < kPacket; ++i) rows[i] = &pool.shadow[slots[i < n ? i : 0]];
+        avx2::rays_to_packet_x8(rows, packet.org_x, packet.org_y, packet.org_z, packet.dir_x, packet.dir_y, packet.dir_z);
+        filled = true;
+      }
+    }
     for (int i = 0; i < kPacket; ++i) {
       valid[i] = i < n ? -1 : 0;
-      if (i < n) set_lane(packet, i, pool.shadow[pool.shadowed[base + i]].ray, 1.0f);
+      if (i < n && !filled) set_lane(packet, i, pool.shadow[slots[i]].ray, 1.0f);
+      packet.tfar[i] = 1.0f;
     }
     occluded_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i) {
-      const uint32_t slot = pool.shadowed[base + i];
+      const uint32_t slot = slots[i];
       if (packet.tfar[i] >= 0.0f) shadow_unoccluded(pool.state[slot], pool.shadow[slot]);
     }
   }
@@ -320,9 +361,9 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
       stage_generate(job, table != nullptr, source, pool);
       if (pool.live.empty()) break;
       stage_final_vertex<T, Kinds>(job, table != nullptr, pool, local);
-      stage_intersect(job, pool, ctx, local);
+      stage_intersect(job, table != nullptr, pool, ctx, local);
       stage_shade<T, Kinds>(job, table.get(), pool, local);
-      stage_shadow(job, pool, ctx);
+      stage_shadow(job, table != nullptr, pool, ctx);
       stage_accumulate(job, pool, local);
     }
   }, tbb::static_partitioner());

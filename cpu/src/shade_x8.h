@@ -275,3 +275,17 @@ namespace pb::cpu::PB_SIMD_NS {
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS
+
+namespace pb::cpu::PB_SIMD_NS {
+
+// A ray (the first six floats of each of eight records: PathState::ray, ShadowQuery::ray)
+// into the arrays of an Embree packet: what set_lane (embree_rays.h) does for floats.
+[[gnu::noinline]] inline void rays_to_packet_x8(const void* const rows[kShadeLanes], float* org_x, float* org_y,
+                                               float* org_z, float* dir_x, float* dir_y, float* dir_z) {
+  F8 r[kLanes];
+  load_rows(rows, 0, r);
+  float* const out[6] = {org_x, org_y, org_z, dir_x, dir_y, dir_z};
+  for (int j = 0; j < 6; ++j) _mm256_storeu_ps(out[j], __m256(r[j]));
+}
+
+}  // namespace pb::cpu::PB_SIMD_NS
