@@ -55,11 +55,13 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   report.state_bytes_per_path = totals.state_bytes_per_path;
   report.paths_in_flight = totals.paths_in_flight;
   report.threads = threads;
-  report.tracer_host_bytes = film.bytes() + totals.pool_bytes + uint64_t(std::max<int64_t>(0, embree.peak_bytes()));
+  report.tracer_host_bytes =
+      film.bytes() + totals.pool_bytes + totals.table_bytes + uint64_t(std::max<int64_t>(0, embree.peak_bytes()));
   report.peak_host_bytes = peak_resident_bytes();
   report.extra["embree_bytes"] = embree.peak_bytes();
   report.extra["film_bytes"] = film.bytes();
   report.extra["pool_bytes"] = totals.pool_bytes;
+  report.extra["shade_table_bytes"] = totals.table_bytes;
 }
 
 }  // namespace pb::cpu

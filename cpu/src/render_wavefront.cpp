@@ -4,6 +4,10 @@
 //   can only add emission: emitter query instead of a closest hit) -> intersect (8-wide
 //   packets) -> shade (shared path step) -> shadow (8-wide packets) -> accumulate
 // Memory is the pool, fixed by --paths-in-flight, never width x height x spp.
+// Diffuse-only float renders on AVX2 CPUs (the paper's benchmark) run generate, final
+// vertex and shade eight paths at a time (shade_x8.h: the path step's arithmetic
+// lane-wise in its own order, so the image stays bit-identical to the pixel strategy's);
+// everything else runs the scalar path step one path at a time.
 // Compiled for one set of material kinds per translation unit (PB_CPU_KINDS,
 // features.h): diffuse-only here, every kind in render_wavefront_all_kinds.cpp, so the
 // diffuse-only code compiles exactly as in a build without the other kinds.
@@ -376,6 +380,7 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
   t.state_bytes_per_path = PoolSlice<T>::bytes_per_path;
   t.paths_in_flight = per_slice * uint64_t(slices);
   t.pool_bytes = t.paths_in_flight * PoolSlice<T>::bytes_per_path;
+  t.table_bytes = table ? table->rows.size() * sizeof(float) : 0;
   return t;
 }
 

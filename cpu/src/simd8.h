@@ -18,7 +18,21 @@ constexpr int kLanes = 8;
 typedef float F8 __attribute__((vector_size(32)));
 typedef int32_t I8 __attribute__((vector_size(32)));  // masks: -1 (true) or 0
 typedef uint32_t U8 __attribute__((vector_size(32)));
-using V3 = Vec3<F8>;                                    // math.h's +, -, *, dot, cross work lane-wise
+
+// Three lanes-vectors: math.h's Vec3 operations, lane-wise and in the same order. (Not
+// Vec3<F8>: math.h's templates would be instantiated outside the AVX2 region, with the
+// baseline calling convention for 32-byte vectors.)
+struct V3 {
+  F8 x, y, z;
+};
+inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator-(V3 a) { return {-a.x, -a.y, -a.z}; }
+inline V3 operator*(V3 a, V3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+inline V3 operator*(V3 a, F8 s) { return {a.x * s, a.y * s, a.z * s}; }
+inline V3 operator/(V3 a, F8 s) { return {a.x / s, a.y / s, a.z / s}; }
+inline F8 dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 
 inline F8 splat(float x) { return F8{} + x; }
 inline I8 splat_i(int32_t x) { return I8{} + x; }

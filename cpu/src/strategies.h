@@ -34,6 +34,7 @@ struct TraceTotals {
   uint64_t state_bytes_per_path = 0;
   uint64_t paths_in_flight = 0;
   uint64_t pool_bytes = 0;
+  uint64_t table_bytes = 0;  // wavefront: the batched shading's per-triangle table (shade_batch.h)
 };
 
 // Rays are counted where they are traced. A path's first ray is its camera ray whatever
@@ -56,7 +57,7 @@ template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
                        [&](auto kinds) { return render_pixel_parallel_for<T, decltype(kinds)::value>(job); });
 }
 // Bounded pool of paths per thread; each stage runs over the whole pool, rays go to
-// Embree in 16-wide packets; finished paths are replaced by new samples.
+// Embree in 8-wide packets; finished paths are replaced by new samples.
 template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight);
 template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   return with_features(job.scene.material_kinds,
