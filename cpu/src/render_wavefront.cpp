@@ -340,14 +340,6 @@ template <class T> void stage_accumulate(const TraceJob& job, PoolSlice<T>& pool
   pool.done.clear();
 }
 
-// The batched shading runs for diffuse-only float renders on AVX2 CPUs, in scenes small
-// enough for its per-triangle table.
-template <class T, uint32_t Kinds> std::unique_ptr<ShadeTable> batched_shading_table(const SceneView& s) {
-  if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly)
-    if (__builtin_cpu_supports("avx2") && ShadeTable::fits(s)) return std::make_unique<ShadeTable>(s);
-  return nullptr;
-}
-
 // The stages above, in scalar type T, compiled for the material kinds `Kinds` (features.h).
 template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   const uint32_t pixels = job.config.width * job.config.height;

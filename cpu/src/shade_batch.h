@@ -3,6 +3,8 @@
 // build's baseline instruction set (shade_x8.h itself is AVX2 code).
 #include <cstdint>
 #include <cstring>
+#include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "pathbench/common/path.h"
@@ -56,5 +58,13 @@ struct ShadeTable {
   }
   const float* row(uint32_t triangle) const { return &rows[size_t(triangle) * kRowFloats]; }
 };
+
+// The batched shading runs for diffuse-only float renders on AVX2 CPUs, in scenes small
+// enough for its table: then this returns the table, otherwise null.
+template <class T, uint32_t Kinds> std::unique_ptr<ShadeTable> batched_shading_table(const SceneView& s) {
+  if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly)
+    if (__builtin_cpu_supports("avx2") && ShadeTable::fits(s)) return std::make_unique<ShadeTable>(s);
+  return nullptr;
+}
 
 }  // namespace pb::cpu

@@ -50,7 +50,9 @@ inline void count_ray(RayCounts& rays, uint32_t depth, uint64_t RayCounts::*othe
 // Each is compiled per set of material kinds `Kinds` (render_*.cpp and
 // render_*_all_kinds.cpp), and the entry points pick one per render from the scene's
 // features (features.h).
-// One thread per image tile; each pixel sample traced alone (rtcIntersect1/rtcOccluded1).
+// One thread per image tile; each pixel sample traced as its own path with single rays
+// (rtcIntersect1/rtcOccluded1), the path steps of up to eight samples of a pixel run
+// side by side where the batched shading applies (render_pixel.cpp).
 template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job);
 template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
   return with_features(job.scene.material_kinds,
