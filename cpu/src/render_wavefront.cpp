@@ -197,8 +197,22 @@ template <class Ray8> void init_packet_constants(Ray8& r) {
   }
 }
 
-// With `batched` (float, AVX2) each packet's rays come from the states by one transpose
-// (rays_to_packet_x8) instead of lane by lane.
+// The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
+// are the ray) into a packet by one transpose (rays_to_packet_x8); false (nothing done)
+// for double records, which the caller converts lane by lane (set_lane).
+template <class Record>
+bool rays_to_packet(const std::vector<Record>& records, const uint32_t* slots, int n, RTCRayNt<kPacket>& r) {
+  if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
+    const void* rows[kPacket];
+    for (int i = 0; i < kPacket; ++i) rows[i] = &records[slots[i < n ? i : 0]];
+    avx2::rays_to_packet_x8(rows, r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z);
+    return true;
+  }
+  return false;
+}
+
+// With `batched` (float, AVX2) each packet's rays come by one transpose (rays_to_packet)
+// instead of lane by lane.
 template <class T>
 void stage_intersect(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCIntersectContext& ctx, Local& local) {
   alignas(64) RTCRayHitNt<kPacket> packet;
@@ -207,16 +221,7 @@ void stage_intersect(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCI
   for (size_t base = 0; base < pool.live.size(); base += kPacket) {
     const int n = int(std::min<size_t>(kPacket, pool.live.size() - base));
     const uint32_t* slots = &pool.live[base];
-    bool filled = false;
-    if constexpr (std::is_same_v<T, float>) {
-      if (batched) {
-        const void* rows[kPacket];
-        for (int i = 0; i < kPacket; ++i) rows[i] = &pool.state[slots[i < n ? i : 0]];
-        RTCRayNt<kPacket>& r = packet.ray;
-        avx2::rays_to_packet_x8(rows, r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z);
-        filled = true;
-      }
-    }
+    const bool filled = batched && rays_to_packet(pool.state, slots, n, packet.ray);
     for (int i = 0; i < kPacket; ++i) {
       valid[i] = i < n ? -1 : 0;
       if (i < n) {
@@ -306,15 +311,7 @@ template <class T> void stage_shadow(const TraceJob& job, bool batched, PoolSlic
   for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
     const int n = int(std::min<size_t>(kPacket, pool.shadowed.size() - base));
     const uint32_t* slots = &pool.shadowed[base];
-    bool filled = false;
-    if constexpr (std::is_same_v<T, float>) {
-      if (batched) {
-        const void* rows[kPacket];
-        for (int i = 0; i < kPacket; ++i) rows[i] = &pool.shadow[slots[i < n ? i : 0]];
-        avx2::rays_to_packet_x8(rows, packet.org_x, packet.org_y, packet.org_z, packet.dir_x, packet.dir_y, packet.dir_z);
-        filled = true;
-      }
-    }
+    const bool filled = batched && rays_to_packet(pool.shadow, slots, n, packet);
     for (int i = 0; i < kPacket; ++i) {
       valid[i] = i < n ? -1 : 0;
       if (i < n && !filled) set_lane(packet, i, pool.shadow[slots[i]].ray, 1.0f);
