@@ -17,13 +17,7 @@
 #include "shade_batch.h"
 #include "strategies.h"
 
-// The batched path step (shade_x8.h), compiled for AVX2 (see render_wavefront.cpp).
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#define PB_SIMD_NS avx2
-#include "shade_x8.h"
-#undef PB_SIMD_NS
-#pragma GCC pop_options
+#include "shade_x8_avx2.h"  // avx2::, the batched path step
 
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly

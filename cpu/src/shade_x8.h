@@ -8,7 +8,7 @@
 // the path step itself.
 //
 // Included in a namespace named by PB_SIMD_NS under `#pragma GCC target("avx2")`
-// (render_wavefront.cpp): eight lanes are one AVX register. (Compiled for the SSE2
+// (shade_x8_avx2.h): eight lanes are one AVX register. (Compiled for the SSE2
 // baseline, every vector operation is two SSE ones, the lane shuffles are scalar code,
 // and the batch costs more than the scalar path step; g++ 12 also fails on an SSE2 and
 // an AVX2 copy in one translation unit.)
