@@ -175,22 +175,46 @@ TEST(Seams, NoPixelIsADarkValleyBeyondNoise) {
 
 // ---- Watertightness -----------------------------------------------------------------
 
+// The closest hit (or a miss, t = inf) of each ray (origin, direction) on the device this
+// suite runs on: the CPU tracer's Embree scene, robust as it renders by default, or the
+// GPU BVH on the device.
+std::vector<float> closest_hit_distances(const Scene& scene, const std::vector<std::pair<Vec3f, Vec3f>>& rays) {
+  constexpr float kMiss = std::numeric_limits<float>::infinity();
+  std::vector<float> t;
+  t.reserve(rays.size());
+#ifdef PB_STABILITY_ON_GPU
+  std::vector<gpu::TraceQuery> queries;
+  for (const auto& [o, d] : rays) queries.push_back({o, d, kMiss});
+  for (const gpu::TraceResult& h : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
+    t.push_back(h.prim == gpu::kNoHit ? kMiss : h.t);
+#else
+  const cpu::EmbreeScene embree(scene, /*watertight=*/true);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (const auto& [o, d] : rays) {
+    RTCRayHit rh{};
+    rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0;
+    rh.ray.tfar = kMiss;
+    rh.ray.mask = ~0u;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(embree.handle(), &ctx, &rh);
+    t.push_back(rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kMiss : rh.ray.tfar);
+  }
+#endif
+  return t;
+}
+
 // Rays from inside a closed mesh aimed exactly at its shared edges and vertices must
 // hit it: none may slip between two triangles (that would end the path: a black seam).
 TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
   PB_REQUIRE_DEVICE();
   for (const Scene& scene : {make_paper_cornell(), transformed(make_paper_cornell(), 1e3f, {1e4f, 0, 0})}) {
-    const cpu::EmbreeScene embree(scene, /*watertight=*/true);  // as the CPU tracer builds it by default
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-#ifdef PB_STABILITY_ON_GPU
-    std::vector<gpu::TraceQuery> queries;
-#endif
-
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     const Vec3f lo = scene.bounds_min, hi = scene.bounds_max;
-    int misses = 0, rays = 0;
+    std::vector<std::pair<Vec3f, Vec3f>> rays;
     for (int i = 0; i < 20000; ++i) {
       // An origin well inside the box (not in the light's thin gap under the ceiling).
       const Vec3f o = lo + (hi - lo) * Vec3f{0.2f + 0.6f * u(rng), 0.2f + 0.5f * u(rng), 0.2f + 0.6f * u(rng)};
@@ -199,29 +223,12 @@ TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
       const int e = int(rng() % 3);
       const Vec3f a = scene.positions[t.v[e]], b = scene.positions[t.v[(e + 1) % 3]];
       const float along = (i % 4 == 0) ? 0.0f : u(rng);  // every fourth ray at a vertex
-      const Vec3f target = a + (b - a) * along;
-      const Vec3f d = target - o;
-      RTCRayHit rh{};
-      rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
-      rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
-      rh.ray.tnear = 0;
-      rh.ray.tfar = std::numeric_limits<float>::infinity();
-      rh.ray.mask = ~0u;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-#ifdef PB_STABILITY_ON_GPU
-      queries.push_back({o, d, std::numeric_limits<float>::infinity()});
-      ++rays;
-#else
-      rtcIntersect1(embree.handle(), &ctx, &rh);
-      ++rays;
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) ++misses;
-#endif
+      rays.push_back({o, a + (b - a) * along - o});
     }
-#ifdef PB_STABILITY_ON_GPU
-    for (const gpu::TraceResult& t : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
-      if (t.prim == gpu::kNoHit) ++misses;
-#endif
-    EXPECT_EQ(misses, 0) << scene.name << ": " << misses << " of " << rays << " rays slipped through an edge";
+    int misses = 0;
+    for (float t : closest_hit_distances(scene, rays))
+      if (t == std::numeric_limits<float>::infinity()) ++misses;
+    EXPECT_EQ(misses, 0) << scene.name << ": " << misses << " of " << rays.size() << " rays slipped through an edge";
   }
 }
 
@@ -290,28 +297,8 @@ TEST(Watertight, RaysAtEdgesOfRandomCoordinateMeshesAllHit) {
     }
   }
   int cracks = 0;
-#ifdef PB_STABILITY_ON_GPU
-  std::vector<gpu::TraceQuery> queries;
-  for (const auto& [o, d] : rays) queries.push_back({o, d, std::numeric_limits<float>::infinity()});
-  const std::vector<gpu::TraceResult> hits = gpu::trace_on_device(scene, queries, /*any_hit=*/false);
-  for (const gpu::TraceResult& h : hits)
-    if (h.prim == gpu::kNoHit || !(h.t <= 1.0f + 1e-4f)) ++cracks;
-#else
-  const cpu::EmbreeScene embree(scene, /*watertight=*/true);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  for (const auto& [o, d] : rays) {
-    RTCRayHit rh{};
-    rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
-    rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
-    rh.ray.tnear = 0;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.mask = ~0u;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(embree.handle(), &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(rh.ray.tfar <= 1.0f + 1e-4f)) ++cracks;
-  }
-#endif
+  for (float t : closest_hit_distances(scene, rays))
+    if (!(t <= 1.0f + 1e-4f)) ++cracks;  // a miss (inf) or a hit beyond the edge
   EXPECT_EQ(cracks, 0) << cracks << " of " << rays.size() << " rays aimed at edges passed through";
 }
 
