@@ -16,6 +16,7 @@ struct RenderOptions {
   std::string scene = "paper-cornell";
   RenderSettings settings;
   std::string sampling = "nee", strategy = "pixel", device = "cpu", precision = "float";
+  std::string embree_layout = "auto";
   bool converged = false;
   std::string out, report, variance_out;
   bool profile = false;

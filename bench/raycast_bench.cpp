@@ -65,18 +65,19 @@ struct Closest {
   uint32_t prim;
   float t;
 };
-Closest closest_hit(RTCScene scene, RTCIntersectContext& ctx, const RaySet& s, size_t i) {
+Closest closest_hit(const cpu::EmbreeScene& embree, RTCIntersectContext& ctx, const RaySet& s, size_t i) {
   RTCRayHit rh;
   set_ray(rh.ray, s, i, kInf);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(scene, &ctx, &rh);
-  return {rh.hit.geomID != RTC_INVALID_GEOMETRY_ID, rh.hit.primID, rh.ray.tfar};
+  rtcIntersect1(embree.handle(), &ctx, &rh);
+  const bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+  return {hit, hit ? embree.triangle(rh.hit) : 0u, rh.ray.tfar};
 }
 void push(RaySet& s, Vec3f o, Vec3f d) {
   s.ox.push_back(o.x); s.oy.push_back(o.y); s.oz.push_back(o.z);
   s.dx.push_back(d.x); s.dy.push_back(d.y); s.dz.push_back(d.z);
 }
-void fill_occlusion_distances(RTCScene scene, RaySet& s) {
+void fill_occlusion_distances(const cpu::EmbreeScene& scene, RaySet& s) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   s.t_occluded.resize(s.size());
@@ -217,7 +218,7 @@ RaySets make_ray_sets(const Scene& scene, const cpu::EmbreeScene& embree, uint32
     PathState<float> st;
     path_begin(view, cfg, pixel, 0, st);
     push(out.coherent, st.ray.o, st.ray.d);
-    const Closest c = closest_hit(embree.handle(), ctx, out.coherent, out.coherent.size() - 1);
+    const Closest c = closest_hit(embree, ctx, out.coherent, out.coherent.size() - 1);
     if (!c.hit) continue;
     const SurfaceHit<float> h = surface_hit(view, c.prim, st.ray);
     const Vec3f n = dot(h.ng, st.ray.d) < 0.0f ? h.ng : -h.ng;  // the side the camera ray came from
@@ -225,8 +226,8 @@ RaySets make_ray_sets(const Scene& scene, const cpu::EmbreeScene& embree, uint32
     const Vec3f d = normalize(Frame<float>::from_normal(n).to_world(sample_cosine_hemisphere(u.v[0], u.v[1])));
     push(out.incoherent, offset_ray_origin(h.p, n, view.offset), d);
   }
-  fill_occlusion_distances(embree.handle(), out.coherent);
-  fill_occlusion_distances(embree.handle(), out.incoherent);
+  fill_occlusion_distances(embree, out.coherent);
+  fill_occlusion_distances(embree, out.incoherent);
   return out;
 }
 

@@ -24,6 +24,14 @@ const char* to_string(Strategy s) {
 }
 const char* to_string(Device d) { return d == Device::Cpu ? "cpu" : "gpu"; }
 const char* to_string(Precision p) { return p == Precision::Float ? "float" : "double"; }
+const char* to_string(EmbreeLayout l) {
+  switch (l) {
+    case EmbreeLayout::Auto: return "auto";
+    case EmbreeLayout::Triangles: return "triangles";
+    case EmbreeLayout::Quads: return "quads";
+  }
+  return "?";
+}
 
 Sampling parse_sampling(std::string_view s) {
   if (s == "uniform") return Sampling::Uniform;
@@ -46,6 +54,13 @@ Precision parse_precision(std::string_view s) {
   if (s == "float") return Precision::Float;
   if (s == "double") return Precision::Double;
   throw InputError(fmt::format("--precision: unknown precision '{}' (expected float or double)", s));
+}
+
+EmbreeLayout parse_embree_layout(std::string_view s) {
+  if (s == "auto") return EmbreeLayout::Auto;
+  if (s == "triangles") return EmbreeLayout::Triangles;
+  if (s == "quads") return EmbreeLayout::Quads;
+  throw InputError(fmt::format("--embree-layout: unknown layout '{}' (expected auto, triangles or quads)", s));
 }
 
 void RenderSettings::validate() const {

@@ -1,6 +1,7 @@
 #include "pathbench/cpu/embree_scene.h"
 
 #include "pathbench/cpu/embree_flags.h"
+#include "pathbench/cpu/embree_layout.h"
 
 #include <fmt/core.h>
 
@@ -24,7 +25,10 @@ bool EmbreeScene::monitor(void* self_ptr, ssize_t bytes, bool) {
   return true;
 }
 
-EmbreeScene::EmbreeScene(const Scene& s, bool watertight) {
+EmbreeScene::EmbreeScene(const Scene& s, bool watertight, EmbreeLayout layout) {
+  if (layout == EmbreeLayout::Auto) layout = choose_embree_layout(s, watertight).layout;
+  quads_ = layout == EmbreeLayout::Quads;
+  if (quads_) pairs_ = pair_triangles(s);
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
   rtcSetDeviceErrorFunction(device_, on_error, nullptr);
@@ -32,13 +36,19 @@ EmbreeScene::EmbreeScene(const Scene& s, bool watertight) {
   scene_ = rtcNewScene(device_);
   rtcSetSceneFlags(scene_, embree_scene_flags(watertight));
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
-  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  RTCGeometry geom = rtcNewGeometry(device_, quads_ ? RTC_GEOMETRY_TYPE_QUAD : RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                         3 * sizeof(float), s.positions.size()));
   std::memcpy(v, s.positions.data(), s.positions.size() * sizeof(Vec3f));
-  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(uint32_t), s.triangles.size()));
-  std::memcpy(idx, s.triangles.data(), s.triangles.size() * sizeof(Triangle));
+  if (quads_) {
+    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4,
+                                                               4 * sizeof(uint32_t), pairs_.quads.size()));
+    std::memcpy(idx, pairs_.quads.data(), pairs_.quads.size() * 4 * sizeof(uint32_t));
+  } else {
+    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(uint32_t), s.triangles.size()));
+    std::memcpy(idx, s.triangles.data(), s.triangles.size() * sizeof(Triangle));
+  }
   rtcCommitGeometry(geom);
   rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);

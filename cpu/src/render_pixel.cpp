@@ -59,7 +59,7 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
     count_ray(local.rays, st.depth, &RayCounts::bounce);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
     bool wants_shadow;
-    const PathEvent ev = path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, rh.hit.primID, st.ray), q, wants_shadow);
+    const PathEvent ev = path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, job.embree.triangle(rh.hit), st.ray), q, wants_shadow);
     if (wants_shadow) occlusion_test(&RayCounts::shadow);
     if (ev == PathEvent::Done) break;
   }
@@ -129,7 +129,7 @@ PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& tabl
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
       batch.st[batch.lanes] = &st[i];
       batch.shadow[batch.lanes] = &q[i];
-      batch.prim[batch.lanes] = rh.hit.primID;
+      batch.prim[batch.lanes] = job.embree.triangle(rh.hit);
       live[batch.lanes++] = i;
     }
     n_live = batch.lanes;

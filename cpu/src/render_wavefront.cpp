@@ -227,7 +227,9 @@ void stage_intersect(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCI
     }
     intersect_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i)
-      pool.prim[slots[i]] = packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : packet.hit.primID[i];
+      pool.prim[slots[i]] = packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID
+                                ? RTC_INVALID_GEOMETRY_ID
+                                : job.embree.triangle(packet.hit.primID[i], packet.hit.u[i], packet.hit.v[i]);
   }
 }
 

@@ -74,7 +74,8 @@ void intersect(const SceneHandle& scene, const RayBatch& rays, Backend backend, 
     t[i] = hit[i] ? tt : kInf;
   };
   if (backend == Backend::Embree) {
-    const RTCScene s = scene.embree(watertight).handle();
+    const cpu::EmbreeScene& embree = scene.embree(watertight);
+    const RTCScene s = embree.handle();
     parallel_rays(rays.n, [&](size_t i) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
@@ -83,7 +84,7 @@ void intersect(const SceneHandle& scene, const RayBatch& rays, Backend backend, 
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(s, &ctx, &rh);
-      store(i, rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? gpu::kNoHit : rh.hit.primID, rh.ray.tfar);
+      store(i, rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? gpu::kNoHit : embree.triangle(rh.hit), rh.ray.tfar);
     });
   } else {
     const gpu::BvhView view = scene.bvh().view();

@@ -40,7 +40,7 @@ class EmbreeReference {
     rtcIntersect1(scene_, &ctx, &rh);
     Hit h;
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-      h.prim = rh.hit.primID;
+      h.prim = embree_.triangle(rh.hit);
       h.t = rh.ray.tfar;
     }
     return h;

@@ -143,6 +143,9 @@ TEST(BadSettings, ZeroWidth) {
 TEST(BadSettings, UnknownStrategy) { expect_input_error([] { parse_strategy("fastest"); }, {"--strategy", "'fastest'"}); }
 TEST(BadSettings, UnknownSampling) { expect_input_error([] { parse_sampling("importance"); }, {"--sampling", "'importance'"}); }
 TEST(BadSettings, UnknownDevice) { expect_input_error([] { parse_device("tpu"); }, {"--device", "'tpu'"}); }
+TEST(BadSettings, UnknownEmbreeLayout) {
+  expect_input_error([] { parse_embree_layout("octagons"); }, {"--embree-layout", "'octagons'"});
+}
 
 }  // namespace
 }  // namespace pb

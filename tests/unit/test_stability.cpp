@@ -175,20 +175,32 @@ TEST(Seams, NoPixelIsADarkValleyBeyondNoise) {
 
 // ---- Watertightness -----------------------------------------------------------------
 
+// What the watertightness tests check: on the CPU both of the tracer's Embree layouts
+// (EmbreeLayout::Auto may pick either), on the GPU its one BVH.
+std::vector<EmbreeLayout> layouts_under_test() {
+#ifdef PB_STABILITY_ON_GPU
+  return {EmbreeLayout::Auto};
+#else
+  return {EmbreeLayout::Triangles, EmbreeLayout::Quads};
+#endif
+}
+
 // The closest hit (or a miss, t = inf) of each ray (origin, direction) on the device this
-// suite runs on: the CPU tracer's Embree scene, robust as it renders by default, or the
-// GPU BVH on the device.
-std::vector<float> closest_hit_distances(const Scene& scene, const std::vector<std::pair<Vec3f, Vec3f>>& rays) {
+// suite runs on: the CPU tracer's Embree scene, robust as it renders by default, in the
+// given layout, or the GPU BVH on the device.
+std::vector<float> closest_hit_distances(const Scene& scene, const std::vector<std::pair<Vec3f, Vec3f>>& rays,
+                                         EmbreeLayout layout) {
   constexpr float kMiss = std::numeric_limits<float>::infinity();
   std::vector<float> t;
   t.reserve(rays.size());
 #ifdef PB_STABILITY_ON_GPU
+  (void)layout;  // one BVH on the GPU
   std::vector<gpu::TraceQuery> queries;
   for (const auto& [o, d] : rays) queries.push_back({o, d, kMiss});
   for (const gpu::TraceResult& h : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
     t.push_back(h.prim == gpu::kNoHit ? kMiss : h.t);
 #else
-  const cpu::EmbreeScene embree(scene, /*watertight=*/true);
+  const cpu::EmbreeScene embree(scene, /*watertight=*/true, layout);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   for (const auto& [o, d] : rays) {
@@ -225,10 +237,13 @@ TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
       const float along = (i % 4 == 0) ? 0.0f : u(rng);  // every fourth ray at a vertex
       rays.push_back({o, a + (b - a) * along - o});
     }
-    int misses = 0;
-    for (float t : closest_hit_distances(scene, rays))
-      if (t == std::numeric_limits<float>::infinity()) ++misses;
-    EXPECT_EQ(misses, 0) << scene.name << ": " << misses << " of " << rays.size() << " rays slipped through an edge";
+    for (EmbreeLayout layout : layouts_under_test()) {
+      int misses = 0;
+      for (float t : closest_hit_distances(scene, rays, layout))
+        if (t == std::numeric_limits<float>::infinity()) ++misses;
+      EXPECT_EQ(misses, 0) << scene.name << " (" << to_string(layout) << "): " << misses << " of " << rays.size()
+                           << " rays slipped through an edge";
+    }
   }
 }
 
@@ -296,10 +311,13 @@ TEST(Watertight, RaysAtEdgesOfRandomCoordinateMeshesAllHit) {
       }
     }
   }
-  int cracks = 0;
-  for (float t : closest_hit_distances(scene, rays))
-    if (!(t <= 1.0f + 1e-4f)) ++cracks;  // a miss (inf) or a hit beyond the edge
-  EXPECT_EQ(cracks, 0) << cracks << " of " << rays.size() << " rays aimed at edges passed through";
+  for (EmbreeLayout layout : layouts_under_test()) {
+    int cracks = 0;
+    for (float t : closest_hit_distances(scene, rays, layout))
+      if (!(t <= 1.0f + 1e-4f)) ++cracks;  // a miss (inf) or a hit beyond the edge
+    EXPECT_EQ(cracks, 0) << to_string(layout) << ": " << cracks << " of " << rays.size()
+                         << " rays aimed at edges passed through";
+  }
 }
 
 // ---- Extremes -----------------------------------------------------------------------

@@ -20,6 +20,11 @@ enum class Device : uint32_t { Cpu = 0, Gpu = 1 };
 // intersector always finds the hit triangle in float (Embree); with Double the hit
 // point is then recomputed in double from the triangle id (surface_hit).
 enum class Precision : uint32_t { Float = 0, Double = 1 };
+// How the CPU tracer hands the triangles to Embree: one by one, or paired across shared
+// edges into Embree quads (cpu/triangle_pairs.h). Which one traces faster depends on
+// the scene; Auto measures both on a short probe and keeps the faster
+// (cpu/embree_layout.h). The GPU ignores it.
+enum class EmbreeLayout : uint32_t { Auto = 0, Triangles = 1, Quads = 2 };
 
 struct PathConfig {
   int32_t max_bounces;        // diffuse reflections; -1 = unbounded (Russian roulette ends paths)
@@ -45,6 +50,7 @@ struct RenderSettings {
   bool variance = false;         // also accumulate per-pixel variance
   bool watertight = true;        // watertight ray/triangle test (CPU: Embree's robust mode)
   Precision precision = Precision::Float;  // scalar type of the path step
+  EmbreeLayout embree_layout = EmbreeLayout::Auto;  // CPU only
   bool progress = true;
 
   PathConfig path_config() const {
@@ -59,9 +65,11 @@ const char* to_string(Sampling s);
 const char* to_string(Strategy s);
 const char* to_string(Device d);
 const char* to_string(Precision p);
+const char* to_string(EmbreeLayout l);
 Sampling parse_sampling(std::string_view s);  // throw InputError on unknown names
 Strategy parse_strategy(std::string_view s);
 Device parse_device(std::string_view s);
 Precision parse_precision(std::string_view s);
+EmbreeLayout parse_embree_layout(std::string_view s);
 
 }  // namespace pb

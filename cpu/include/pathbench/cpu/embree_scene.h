@@ -1,23 +1,32 @@
 #pragma once
 // An Embree device and scene built from pathbench's flat arrays, with Embree's own
-// memory use tracked through its memory monitor.
+// memory use tracked through its memory monitor. The triangles go to Embree one by one
+// or paired into quads (EmbreeLayout, settings.h; triangle_pairs.h). Embree's primitive
+// ids are then quads: map every hit back to the scene's triangle with triangle().
 #include <embree3/rtcore.h>
 
 #include <atomic>
 #include <cstdint>
 
 #include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+#include "pathbench/cpu/triangle_pairs.h"
 
 namespace pb::cpu {
 
 class EmbreeScene {
  public:
-  EmbreeScene(const Scene& scene, bool watertight);
+  // Auto: the layout choose_embree_layout (embree_layout.h) measures to be faster.
+  EmbreeScene(const Scene& scene, bool watertight, EmbreeLayout layout = EmbreeLayout::Auto);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
   RTCScene handle() const { return scene_; }
+  EmbreeLayout layout() const { return quads_ ? EmbreeLayout::Quads : EmbreeLayout::Triangles; }
+  // The scene triangle of a hit on Embree primitive `prim` at hit coordinates (u, v).
+  uint32_t triangle(uint32_t prim, float u, float v) const { return quads_ ? pairs_.triangle_of(prim, u, v) : prim; }
+  uint32_t triangle(const RTCHit& h) const { return triangle(h.primID, h.u, h.v); }
   int64_t bytes() const { return bytes_.load(); }
   int64_t peak_bytes() const { return peak_bytes_.load(); }
 
@@ -25,6 +34,8 @@ class EmbreeScene {
   static bool monitor(void* self, ssize_t bytes, bool post);
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  bool quads_ = false;
+  TrianglePairs pairs_;  // where quads_
   std::atomic<int64_t> bytes_{0};
   std::atomic<int64_t> peak_bytes_{0};
 };

@@ -1,0 +1,31 @@
+#pragma once
+// EmbreeLayout::Auto: which layout (settings.h) Embree traces a scene faster with. In
+// robust mode the answer depends on the scene -- paired into quads, paper-cornell took
+// 22% fewer instructions per sample and cornell-box 21% more (notes/cpu-performance.md)
+// -- so it is measured, not guessed: both layouts trace the same probe rays (camera rays,
+// rays leaving random surface points, shadow rays to the emitters), in alternating
+// rounds, and quads are kept only when clearly faster. The answer is remembered per scene
+// for the life of the process, so every render of a scene in one process (pixel and
+// wavefront, say) traces the same layout. Pin the layout (--embree-layout) where runs in
+// different processes must trace alike.
+#include <cstddef>
+
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+
+namespace pb::cpu {
+
+struct LayoutChoice {
+  EmbreeLayout layout = EmbreeLayout::Triangles;
+  size_t paired = 0;           // triangles that pair up across shared edges
+  double triangles_ns = 0.0;   // probe: best round, nanoseconds per ray (0: not probed)
+  double quads_ns = 0.0;
+  const char* reason = "";     // why this layout, in words
+};
+
+// Probed only when at least 90% of the triangles pair up (else Triangles: unpaired
+// triangles are half-empty quads) and the scene has at most 2^16 triangles (building
+// it twice stays cheap; on paper-cornell-ico:6, 82k triangles, quads were 1-4% slower).
+LayoutChoice choose_embree_layout(const Scene& scene, bool watertight);
+
+}  // namespace pb::cpu
