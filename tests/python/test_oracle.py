@@ -222,7 +222,9 @@ def _markdown(meta, rows):
         "",
         f"`PATHBENCH_ORACLE_OUT=results/amd-epyc .venv/bin/python -m pytest -s tests/python/test_oracle.py` at "
         f"{meta['source_revision']} (module built at {meta['git_revision']}) on {meta['cpu']}. Reference: "
-        f"{meta['reference']}. Backends: `embree` = the CPU tracer's Embree 3 scene (robust; triangles or quads as `--embree-layout auto` picks them: quads pick the other triangle of a shared edge, a tie, where embreex's triangles pick one), `bvh` = the GPU "
+        f"{meta['reference']}. Backends: `embree` = the CPU tracer's Embree 3 scene (robust; triangles or "
+        "quads as `--embree-layout auto` picks them: quads pick the other triangle of a shared edge, a tie, "
+        "where embreex's triangles pick one), `bvh` = the GPU "
         "BVH traversal run on the host. Rays per scene (2^20): 40% random from inside the bounds, 20% from "
         "outside, 20% grazing (1e-5..1e-1 rad to a triangle's plane), 20% aimed exactly at edges and vertices. "
         "Rays whose origin float32 rounding put onto a surface (Embree hits them at t = 0, the GPU traversal "
