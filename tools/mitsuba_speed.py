@@ -143,7 +143,26 @@ class PathbenchRunner:
             "compiler": med.get("compiler"),
             "peak_host_bytes": med.get("peak_host_bytes"),
             "image_mean_rgb": med["image_mean_rgb"],
+            "embree_layout": med.get("embree_layout"),  # the report's: asked, used, why, probe times
         }
+
+
+def layout_lines(pb):
+    """Which Embree layout each pathbench run traced (`--embree-layout auto` decides per
+    process, from a probe it times), so the table says what was measured."""
+    parts = []
+    for strategy, r in pb.items():
+        lay = r.get("embree_layout")
+        if not lay:
+            continue
+        probe = lay.get("probe_ns_per_ray")
+        timed = (f", probe {probe['triangles']:.0f} ns/ray as triangles, {probe['quads']:.0f} as quads"
+                 if probe else "")
+        parts.append(f"{strategy}: {lay['used']} ({lay['why']}{timed})")
+    if not parts:
+        return []
+    return ["pathbench's Embree layout (`--embree-layout " + next(iter(pb.values()))["embree_layout"]["asked"]
+            + "`; the raw rates above come from the same choice): " + "; ".join(parts) + "."]
 
 
 def markdown(res):
@@ -201,6 +220,7 @@ def markdown(res):
         "only rays traced). `no-watertight`: Embree without its robust mode (faster; rays can slip through edges).",
         f"Image means (R, G, B): Mitsuba {m['image_mean_rgb']}, pathbench "
         f"{next(iter(pb.values()))['image_mean_rgb']}.",
+        *layout_lines(pb),
         f"pathbench revision {next(iter(pb.values()))['git_revision']}, {next(iter(pb.values()))['compiler']}.",
         "",
         "Re-run: `.venv/bin/python tools/mitsuba_speed.py` (after `scripts/build.sh`).",

@@ -60,6 +60,17 @@ def test_speed_markdown():
     assert "| pathbench cpu/pixel | 20.00" in md
     assert "2.00x" in md
     assert "estimate" in md
+    assert "Embree layout" not in md  # reports from before the layout choice have none
+
+
+def test_speed_markdown_names_the_embree_layout():
+    res = _speed_result()
+    res["pathbench"]["pixel"]["embree_layout"] = {
+        "asked": "auto", "used": "quads", "why": "quads measured faster",
+        "probe_ns_per_ray": {"triangles": 94.0, "quads": 68.0}}
+    md = mitsuba_speed.markdown(res)
+    assert ("pathbench's Embree layout (`--embree-layout auto`; the raw rates above come from the same choice): "
+            "pixel: quads (quads measured faster, probe 94 ns/ray as triangles, 68 as quads).") in md
 
 
 def _rates(camera, bounce, shadow, width):
