@@ -68,7 +68,11 @@ def build(build_dir: Path, extra_materials: bool, jobs: int):
 
 def render_args(a, strategy):
     return ["render", "--scene", "paper-cornell", "--width", str(a.size), "--height", str(a.size), "--spp", str(a.spp),
-            "--bounces", "2", "--sampling", "nee", "--strategy", strategy, "--threads", "1", "--quiet"]
+            "--bounces", "2", "--sampling", "nee", "--strategy", strategy, "--threads", "1", "--quiet",
+            # Pinned: `auto` times a probe in each process (and under valgrind its timing means
+            # little), and the two builds must trace the same layout. Quads: what auto picks for
+            # paper-cornell when it runs at full speed (results/amd-epyc/mitsuba-vs-pathbench.md).
+            "--embree-layout", "quads"]
 
 
 def callgrind_instructions(binary: Path, a, strategy: str) -> int:
