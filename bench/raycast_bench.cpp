@@ -204,6 +204,7 @@ void run_raycast(benchmark::State& state, const RaycastCase& c, Api api, bool co
   state.counters["hit_fraction"] = double(hits) / double(rays.size());
   state.counters["triangles"] = double(cached_scene(c.scene)->triangles.size());
   state.counters["threads"] = double(tbb::this_task_arena::max_concurrency());
+  state.SetLabel(std::string("embree_layout=") + to_string(prep->embree->layout()));  // as render benchmarks
 }
 
 }  // namespace

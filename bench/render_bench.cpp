@@ -80,6 +80,10 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   state.counters["pixels_x_spp"] = double(s.total_samples());
   state.counters["triangles"] = double(scene->triangles.size());
   state.counters["threads"] = double(last.threads);
+  // Which Embree layout the CPU traced (auto decides per scene and process): a change of
+  // layout between two runs shows here, not only as a change of speed.
+  if (last.extra.contains("embree_layout"))
+    state.SetLabel("embree_layout=" + last.extra["embree_layout"]["used"].get<std::string>());
 }
 
 }  // namespace
