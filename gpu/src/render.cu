@@ -29,10 +29,6 @@ namespace {
 
 constexpr unsigned kFullMask = 0xFFFFFFFFu;
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// film.cpp's kMaxSum: the largest per-pixel fixed-point sum (2^62). Film::acceptable
-// rejects a sample whose channel reaches a quarter of it divided by the scale; the
-// device applies the same limit (tests/gpu checks the two agree).
-constexpr double kFilmMaxSum = 4611686018427387904.0;
 
 // ---------------------------------------------------------------------------------
 // Film and counters on the device.
@@ -42,7 +38,7 @@ struct FilmDev {
   uint32_t* count;
   double* sum_sq;           // null unless variance is kept
   double scale;
-  double limit;             // a channel must stay strictly below this (Film::acceptable)
+  double limit;             // a channel must stay strictly below this (Film::sample_limit)
 };
 
 __device__ __forceinline__ bool sample_acceptable(const Vec3f& L, double limit) {
@@ -628,7 +624,7 @@ struct FilmBuffers {
     sum.allocate(pixels * 3, "the film", lower);
     count.allocate(pixels, "the film", lower);
     if (film.has_variance()) sum_sq.allocate(pixels * 3, "the film's variance (--variance-out)", lower);
-    view = {sum.get(), count.get(), sum_sq.get(), film.scale(), kFilmMaxSum / 4 / film.scale()};
+    view = {sum.get(), count.get(), sum_sq.get(), film.scale(), film.sample_limit()};
   }
   void clear(cudaStream_t s) {
     PB_CUDA_CHECK(cudaMemsetAsync(sum.get(), 0, sum.bytes(), s));

@@ -43,9 +43,11 @@ class Film {
   // (Inline, below: they run once per sample in the tracers' inner loops.)
   bool add(uint32_t pixel, Vec3f L);         // single writer per pixel
   bool add_atomic(uint32_t pixel, Vec3f L);  // many writers
-  static bool acceptable(Vec3f L, double scale);
   // Largest per-pixel sum (2^62); one sample may use at most a quarter of it.
   static constexpr double kMaxSum = 4611686018427387904.0;
+  // Every channel of an accepted sample is finite and strictly below this: kMaxSum / 4 /
+  // scale(). The GPU's film applies the same bound.
+  double sample_limit() const { return limit_; }
 
   uint32_t width() const { return width_; }
   uint32_t height() const { return height_; }
@@ -66,7 +68,7 @@ class Film {
   std::vector<double>& raw_sum_sq() { return sum_sq_; }
 
  private:
-  bool accepts(Vec3f L) const {  // acceptable(L, scale_), its limit computed once in begin()
+  bool accepts(Vec3f L) const {
     return is_finite(L) && std::fabs(L.x) < limit_ && std::fabs(L.y) < limit_ && std::fabs(L.z) < limit_;
   }
 
@@ -77,12 +79,6 @@ class Film {
   std::vector<uint32_t> count_;
   std::vector<double> sum_sq_;
 };
-
-inline bool Film::acceptable(Vec3f L, double scale) {
-  if (!is_finite(L)) return false;
-  const double limit = kMaxSum / 4 / scale;
-  return std::fabs(L.x) < limit && std::fabs(L.y) < limit && std::fabs(L.z) < limit;
-}
 
 // Host only (std::atomic_ref is C++20; nvcc may compile this header as C++17, and the
 // GPU accumulates with atomicAdd of its own).
