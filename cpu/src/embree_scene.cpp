@@ -1,7 +1,6 @@
 #include "pathbench/cpu/embree_scene.h"
 
 #include "pathbench/cpu/embree_flags.h"
-#include "pathbench/cpu/embree_layout.h"
 
 #include <fmt/core.h>
 
@@ -26,8 +25,9 @@ bool EmbreeScene::monitor(void* self_ptr, ssize_t bytes, bool) {
 }
 
 EmbreeScene::EmbreeScene(const Scene& s, bool watertight, EmbreeLayout layout) {
-  if (layout == EmbreeLayout::Auto) layout = choose_embree_layout(s, watertight).layout;
-  quads_ = layout == EmbreeLayout::Quads;
+  choice_ = layout == EmbreeLayout::Auto ? choose_embree_layout(s, watertight)
+                                         : LayoutChoice{layout, 0, 0.0, 0.0, "asked for"};
+  quads_ = choice_.layout == EmbreeLayout::Quads;
   if (quads_) pairs_ = pair_triangles(s);
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));

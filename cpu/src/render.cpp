@@ -7,7 +7,6 @@
 #include <chrono>
 #include <memory>
 
-#include "pathbench/cpu/embree_layout.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/common/errors.h"
 #include "strategies.h"
@@ -28,10 +27,7 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
   const int threads = settings.threads > 0 ? settings.threads : tbb::this_task_arena::max_concurrency();
 
-  const LayoutChoice layout = settings.embree_layout == EmbreeLayout::Auto
-                                  ? choose_embree_layout(scene, settings.watertight)
-                                  : LayoutChoice{settings.embree_layout, 0, 0.0, 0.0, "asked for"};
-  EmbreeScene embree(scene, settings.watertight, layout.layout);
+  EmbreeScene embree(scene, settings.watertight, settings.embree_layout);
   film.begin(settings.spp, scene.max_emission());
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
                     settings.total_samples(), settings.progress);
@@ -63,8 +59,9 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
       film.bytes() + totals.pool_bytes + totals.table_bytes + uint64_t(std::max<int64_t>(0, embree.peak_bytes()));
   report.peak_host_bytes = peak_resident_bytes();
   report.extra["embree_bytes"] = embree.peak_bytes();
+  const LayoutChoice& layout = embree.layout_choice();
   report.extra["embree_layout"] = {{"asked", to_string(settings.embree_layout)},
-                                   {"used", to_string(embree.layout())},
+                                   {"used", to_string(layout.layout)},
                                    {"why", layout.reason},
                                    {"probe_ns_per_ray", nullptr}};
   if (layout.triangles_ns > 0)

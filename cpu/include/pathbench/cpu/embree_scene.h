@@ -10,6 +10,7 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
+#include "pathbench/cpu/embree_layout.h"
 #include "pathbench/cpu/triangle_pairs.h"
 
 namespace pb::cpu {
@@ -23,7 +24,8 @@ class EmbreeScene {
   EmbreeScene& operator=(const EmbreeScene&) = delete;
 
   RTCScene handle() const { return scene_; }
-  EmbreeLayout layout() const { return quads_ ? EmbreeLayout::Quads : EmbreeLayout::Triangles; }
+  EmbreeLayout layout() const { return choice_.layout; }  // Triangles or Quads, never Auto
+  const LayoutChoice& layout_choice() const { return choice_; }  // and why, with the probe's times
   // The scene triangle of a hit on Embree primitive `prim` at hit coordinates (u, v).
   uint32_t triangle(uint32_t prim, float u, float v) const { return quads_ ? pairs_.triangle_of(prim, u, v) : prim; }
   uint32_t triangle(const RTCHit& h) const { return triangle(h.primID, h.u, h.v); }
@@ -34,7 +36,8 @@ class EmbreeScene {
   static bool monitor(void* self, ssize_t bytes, bool post);
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
-  bool quads_ = false;
+  LayoutChoice choice_;
+  bool quads_ = false;   // choice_.layout == Quads
   TrianglePairs pairs_;  // where quads_
   std::atomic<int64_t> bytes_{0};
   std::atomic<int64_t> peak_bytes_{0};
