@@ -80,19 +80,8 @@ double trace_ns_per_ray(const EmbreeScene& e, const ProbeRays& r) {
   rtcInitIntersectContext(&ctx);
   uint32_t hits = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  for (const Ray<float>& ray : r.closest) {
-    RTCRayHit rh;
-    to_embree(ray, kInfinity, rh.ray);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(e.handle(), &ctx, &rh);
-    hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-  }
-  for (const Ray<float>& ray : r.shadow) {
-    RTCRay sr;
-    to_embree(ray, 0.999f, sr);
-    rtcOccluded1(e.handle(), &ctx, &sr);
-    hits += sr.tfar < 0.0f;
-  }
+  for (const Ray<float>& ray : r.closest) hits += closest_triangle(e, ctx, ray) != RTC_INVALID_GEOMETRY_ID;
+  for (const Ray<float>& ray : r.shadow) hits += occluded(e, ctx, ray, 0.999f);
   const auto t1 = std::chrono::steady_clock::now();
   asm volatile("" : : "r"(hits));  // the loops' results are used
   return std::chrono::duration<double, std::nano>(t1 - t0).count() / double(r.closest.size() + r.shadow.size());

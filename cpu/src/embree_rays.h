@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pathbench/common/camera.h"
+#include "pathbench/cpu/embree_scene.h"
 
 namespace pb::cpu {
 
@@ -32,5 +33,23 @@ template <int N, class T> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<
 }
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// The scene triangle the ray hits first (t >= 0), or RTC_INVALID_GEOMETRY_ID: one
+// rtcIntersect1, its hit mapped back to the scene's triangle (the layout may be quads).
+template <class T> inline uint32_t closest_triangle(const EmbreeScene& e, RTCIntersectContext& ctx, const Ray<T>& r) {
+  RTCRayHit rh;
+  to_embree(r, kInfinity, rh.ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(e.handle(), &ctx, &rh);
+  return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID : e.triangle(rh.hit);
+}
+
+// Whether anything blocks the ray before t = tfar (one rtcOccluded1).
+template <class T> inline bool occluded(const EmbreeScene& e, RTCIntersectContext& ctx, const Ray<T>& r, float tfar) {
+  RTCRay sr;
+  to_embree(r, tfar, sr);
+  rtcOccluded1(e.handle(), &ctx, &sr);
+  return sr.tfar < 0.0f;  // Embree marks an occluded ray with tfar = -inf
+}
 
 }  // namespace pb::cpu

@@ -41,25 +41,19 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
   path_begin(job.scene, job.config, pixel, sample, st);
   ShadowQuery<T> q;
   auto occlusion_test = [&](uint64_t RayCounts::*kind) {
-    RTCRay sr;
-    to_embree(q.ray, 1.0f, sr);
-    rtcOccluded1(job.embree.handle(), &ctx, &sr);
     count_ray(local.rays, st.depth, kind);
-    if (sr.tfar >= 0.0f) shadow_unoccluded(st, q);
+    if (!occluded(job.embree, ctx, q.ray, 1.0f)) shadow_unoccluded(st, q);
   };
   for (;;) {
     if (path_at_final_vertex(job.scene, job.config, st)) {  // only emitted light can still count
       if (path_final_query<Kinds>(job.scene, job.config, st, q)) occlusion_test(&RayCounts::shadow);
       break;
     }
-    RTCRayHit rh;
-    to_embree(st.ray, kInfinity, rh.ray);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(job.embree.handle(), &ctx, &rh);
+    const uint32_t prim = closest_triangle(job.embree, ctx, st.ray);
     count_ray(local.rays, st.depth, &RayCounts::bounce);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+    if (prim == RTC_INVALID_GEOMETRY_ID) break;
     bool wants_shadow;
-    const PathEvent ev = path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, job.embree.triangle(rh.hit), st.ray), q, wants_shadow);
+    const PathEvent ev = path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, prim, st.ray), q, wants_shadow);
     if (wants_shadow) occlusion_test(&RayCounts::shadow);
     if (ev == PathEvent::Done) break;
   }
@@ -83,11 +77,8 @@ PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& tabl
   }
   avx2::begin_paths_x8(job.scene, job.config, pixels, samples, lanes, count);
   auto occlusion_test = [&](int i, uint64_t RayCounts::*kind) {
-    RTCRay sr;
-    to_embree(q[i].ray, 1.0f, sr);
-    rtcOccluded1(job.embree.handle(), &ctx, &sr);
     count_ray(local.rays, st[i].depth, kind);
-    if (sr.tfar >= 0.0f) shadow_unoccluded(st[i], q[i]);
+    if (!occluded(job.embree, ctx, q[i].ray, 1.0f)) shadow_unoccluded(st[i], q[i]);
   };
   int live[kShadeLanes], n_live = count;
   for (int i = 0; i < count; ++i) live[i] = i;
@@ -121,15 +112,12 @@ PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& tabl
     batch.lanes = 0;
     for (int k = 0; k < n_live; ++k) {
       const int i = live[k];
-      RTCRayHit rh;
-      to_embree(st[i].ray, kInfinity, rh.ray);
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(job.embree.handle(), &ctx, &rh);
+      const uint32_t prim = closest_triangle(job.embree, ctx, st[i].ray);
       count_ray(local.rays, st[i].depth, &RayCounts::bounce);
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      if (prim == RTC_INVALID_GEOMETRY_ID) continue;
       batch.st[batch.lanes] = &st[i];
       batch.shadow[batch.lanes] = &q[i];
-      batch.prim[batch.lanes] = job.embree.triangle(rh.hit);
+      batch.prim[batch.lanes] = prim;
       live[batch.lanes++] = i;
     }
     n_live = batch.lanes;
