@@ -6,7 +6,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
-apt_pkgs=(build-essential cmake ninja-build pkg-config git python3 python3-venv
+apt_pkgs=(build-essential cmake ninja-build ccache pkg-config git python3 python3-venv
           libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
           librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
           libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev
