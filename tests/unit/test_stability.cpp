@@ -17,73 +17,14 @@
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/render.h"
 #include "furnace_check.h"
+#include "stability_device.h"
 #include "stat_test.h"
 #ifdef PB_STABILITY_ON_GPU
 #include "pathbench/gpu/bvh.h"
-#include "pathbench/gpu/render.h"
 #endif
 
 namespace pb {
 namespace {
-
-// At the top of every test: on the GPU build, SKIPPED (with the reason) without a GPU.
-#ifdef PB_STABILITY_ON_GPU
-#define PB_REQUIRE_DEVICE()                                    \
-  do {                                                         \
-    std::string why;                                           \
-    if (!gpu::device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
-  } while (0)
-#else
-#define PB_REQUIRE_DEVICE() \
-  do {                      \
-  } while (0)
-#endif
-
-// The scene with every point p moved to p * scale + offset (the camera too), then
-// finalized again so ray offsets follow the new extent.
-Scene transformed(Scene s, float scale, Vec3f offset) {
-  for (Vec3f& p : s.positions) p = p * scale + offset;
-  s.camera.position = s.camera.position * scale + offset;
-  s.finalize();
-  return s;
-}
-
-struct Rendered {
-  Film film;
-  RunReport report;
-};
-
-Rendered render(const Scene& scene, RenderSettings s) {
-  s.progress = false;
-  Rendered r{Film(s.width, s.height, s.variance), {}};
-#ifdef PB_STABILITY_ON_GPU
-  s.strategy = Strategy::Pixel;
-  gpu::render(scene, s, r.film, r.report, false);
-  // The wavefront must agree bit for bit, extremes included (it has queues to overflow
-  // and counters to wrap that the megakernel has not).
-  RenderSettings w = s;
-  w.strategy = Strategy::Wavefront;
-  Film wf(s.width, s.height, s.variance);
-  RunReport wr;
-  gpu::render(scene, w, wf, wr, false);
-  EXPECT_TRUE(wf.raw_sums() == r.film.raw_sums()) << "GPU wavefront film differs from pixel's";
-  EXPECT_TRUE(wf.counts() == r.film.counts()) << "GPU wavefront sample counts differ from pixel's";
-  EXPECT_EQ(wr.discarded_samples, r.report.discarded_samples);
-#else
-  cpu::render(scene, s, r.film, r.report);
-#endif
-  return r;
-}
-
-// A square image with light sampling: the settings every test here starts from.
-RenderSettings nee_settings(uint32_t size, uint32_t spp, int bounces) {
-  RenderSettings s;
-  s.width = s.height = size;
-  s.spp = spp;
-  s.max_bounces = bounces;
-  s.sampling = Sampling::Nee;
-  return s;
-}
 
 RenderSettings small_settings() {
   RenderSettings s = nee_settings(64, 64, 2);
