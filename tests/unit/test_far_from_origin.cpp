@@ -225,5 +225,55 @@ TEST_P(SpawnedRays, CameraLightPdfAndNormalsAreInvariant) {
   }
 }
 
+// ---- The rebase ---------------------------------------------------------------------
+
+// Scenes near the origin are traced where they are: no built-in moves, so their images
+// and reports stay what they were.
+TEST(Rebase, ScenesNearTheOriginStayWhereTheyAre) {
+  for (const Scene& s : {make_paper_cornell(), make_cornell_box(), transformed(make_paper_cornell(), 1e5f, {0, 0, 0}),
+                         transformed(make_paper_cornell(), 1e-4f, {0, 0, 0})})
+    EXPECT_TRUE(is_zero(s.origin)) << s.name;
+}
+
+// A moved scene is traced next to the origin, and traced + origin gives back exactly the
+// floats it was given (the subtraction is exact); a second transform composes in the
+// user's coordinates.
+TEST(Rebase, MovedSceneIsTracedNearTheOriginAndExactlyRecoverable) {
+  const Scene box = make_paper_cornell();
+  for (const Placement& pl : kPlacements) {
+    const Scene s = transformed(box, pl.scale, pl.offset);
+    const float extent = s.features.extent;
+    for (size_t i = 0; i < s.positions.size(); ++i) {
+      const Vec3f user = box.positions[i] * pl.scale + pl.offset;  // what the scene was given
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(s.positions[i][k] + s.origin[k], user[k]) << pl.name << " vertex " << i;
+        EXPECT_LE(std::fabs(s.positions[i][k]), extent) << pl.name << ": traced far from the origin";
+      }
+    }
+    const float unmoved_extent = transformed(box, pl.scale, {0, 0, 0}).features.extent;  // up to input rounding
+    EXPECT_NEAR(s.features.extent, unmoved_extent, 1e-4f * unmoved_extent) << pl.name;
+    // Scaled again by 2: the user's coordinates double.
+    const Scene twice = transformed(s, 2.0f, {0, 0, 0});
+    for (size_t i = 0; i < s.positions.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(twice.positions[i][k] + twice.origin[k], 2.0f * (s.positions[i][k] + s.origin[k])) << pl.name;
+  }
+}
+
+// The warning: none where images are unchanged (1e5: 5,600 float steps across the box),
+// one naming the scene where the input's rounding is coarse (1e6: 700 steps).
+TEST(Rebase, WarnsWhenTheInputIsRoundedCoarselyForItsSize) {
+  const Scene box = make_paper_cornell();
+  ::testing::internal::CaptureStderr();
+  (void)transformed(box, 1, {1e5f, 1e5f, 1e5f});
+  (void)transformed(box, 1e-4f, {1, 1, 1});
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  ::testing::internal::CaptureStderr();
+  (void)transformed(box, 1, {1e6f, 0, 0});
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("warning: paper-cornell:"), std::string::npos) << err;
+  EXPECT_NE(err.find("from the origin"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace pb
