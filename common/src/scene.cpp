@@ -97,6 +97,7 @@ void Scene::finalize() {
     }
   features = {};
   features.extent = length(bounds_max - bounds_min);
+  rebase_far_from_origin();  // scene_origin.cpp; the extent does not change
   offset = RayOffset::for_extent(features.extent);
 
   // Emitters, chosen in proportion to their power (area x mean emission).

@@ -50,6 +50,20 @@ FloatArray rows3(const py::object& obj, const char* what) {
   return a;
 }
 
+// Ray origins in the user's coordinates, as the scene traces them: minus the scene's
+// origin (Scene::origin, nonzero only for a scene finalize() moved next to the origin),
+// taken in double so that float64 input keeps its digits until that subtraction.
+FloatArray traced_origins(const py::object& obj, Vec3f origin) {
+  FloatArray a = rows3(obj, "origins");
+  if (is_zero(origin)) return a;
+  const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
+  FloatArray out(std::vector<py::ssize_t>{a.shape(0), 3});
+  float* o = out.mutable_data();
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    for (int k = 0; k < 3; ++k) o[3 * i + k] = float(d.at(i, k) - double(origin[k]));
+  return out;
+}
+
 // tnear / tfar: one number for every ray, or an array of shape (N,).
 struct PerRay {
   FloatArray values;
@@ -70,9 +84,9 @@ struct Batch {
   PerRay tn, tf;
   pb::python::RayBatch rays;
 };
-Batch make_batch(const py::object& origins, const py::object& directions, const py::object& tnear,
-                 const py::object& tfar) {
-  Batch b{rows3(origins, "origins"), rows3(directions, "directions"), {}, {}, {}};
+Batch make_batch(const SceneHandle& s, const py::object& origins, const py::object& directions,
+                 const py::object& tnear, const py::object& tfar) {
+  Batch b{traced_origins(origins, s.scene().origin), rows3(directions, "directions"), {}, {}, {}};
   const size_t n = size_t(b.o.shape(0));
   if (size_t(b.d.shape(0)) != n)
     throw InputError(fmt::format("origins and directions must have the same number of rows ({} != {})", n,
@@ -85,7 +99,7 @@ Batch make_batch(const py::object& origins, const py::object& directions, const 
 
 py::dict intersect(const SceneHandle& s, const py::object& origins, const py::object& directions,
                    const py::object& tnear, const py::object& tfar, const std::string& backend, bool watertight) {
-  const Batch b = make_batch(origins, directions, tnear, tfar);
+  const Batch b = make_batch(s, origins, directions, tnear, tfar);
   const auto be = pb::python::parse_backend(backend);
   // Shape as a container: array_t(count) comes out with stride 0 in pybind11 2.10.
   const std::vector<py::ssize_t> shape{py::ssize_t(b.rays.n)};
@@ -109,7 +123,7 @@ py::dict intersect(const SceneHandle& s, const py::object& origins, const py::ob
 py::array_t<bool> occluded(const SceneHandle& s, const py::object& origins, const py::object& directions,
                            const py::object& tnear, const py::object& tfar, const std::string& backend,
                            bool watertight) {
-  const Batch b = make_batch(origins, directions, tnear, tfar);
+  const Batch b = make_batch(s, origins, directions, tnear, tfar);
   const auto be = pb::python::parse_backend(backend);
   py::array_t<bool> out(std::vector<py::ssize_t>{py::ssize_t(b.rays.n)});
   bool* o = out.mutable_data();
@@ -123,7 +137,7 @@ py::array_t<bool> occluded(const SceneHandle& s, const py::object& origins, cons
 std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::array<float, 3> offset) {
   py::gil_scoped_release release;
   return std::make_shared<SceneHandle>(
-      pb::python::transformed(load_scene(name), scale, Vec3f{offset[0], offset[1], offset[2]}));
+      pb::transformed(load_scene(name), scale, Vec3f{offset[0], offset[1], offset[2]}));
 }
 
 py::tuple render(const SceneHandle& s, uint32_t width, uint32_t height, uint32_t spp, int max_bounces,
@@ -183,9 +197,18 @@ PYBIND11_MODULE(pathbench, m) {
       .def_property_readonly("positions",
                              [](py::object self) -> py::array {
                                const auto& s = self.cast<const SceneHandle&>().scene();
-                               return view(&s.positions.data()->x, {py::ssize_t(s.positions.size()), 3}, self);
+                               const std::vector<py::ssize_t> shape{py::ssize_t(s.positions.size()), 3};
+                               if (is_zero(s.origin)) return view(&s.positions.data()->x, shape, self);
+                               // Moved next to the origin to be traced: give back the user's
+                               // coordinates (exactly the floats it was given).
+                               py::array_t<float> a(shape);
+                               float* p = a.mutable_data();
+                               for (size_t i = 0; i < s.positions.size(); ++i)
+                                 for (int k = 0; k < 3; ++k) p[3 * i + k] = s.positions[i][k] + s.origin[k];
+                               a.attr("setflags")(py::arg("write") = false);
+                               return std::move(a);
                              },
-                             "(N, 3) float32 vertex positions (read-only view)")
+                             "(N, 3) float32 vertex positions (read-only)")
       .def_property_readonly("triangles",
                              [](py::object self) -> py::array {
                                const auto& s = self.cast<const SceneHandle&>().scene();
@@ -203,8 +226,8 @@ PYBIND11_MODULE(pathbench, m) {
                                py::array_t<float> b({2, 3});
                                float* p = b.mutable_data();
                                for (int k = 0; k < 3; ++k) {
-                                 p[k] = s.bounds_min[k];
-                                 p[3 + k] = s.bounds_max[k];
+                                 p[k] = s.bounds_min[k] + s.origin[k];  // user coordinates
+                                 p[3 + k] = s.bounds_max[k] + s.origin[k];
                                }
                                return b;
                              },

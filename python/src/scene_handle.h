@@ -12,11 +12,6 @@
 
 namespace pb::python {
 
-// The scene with every point p moved to p * scale + offset (the camera too), then
-// finalized again so bounds and ray offsets follow the new extent. Throws InputError
-// for a scale that is not finite and positive or an offset that is not finite.
-Scene transformed(Scene s, float scale, Vec3f offset);
-
 class SceneHandle {
  public:
   explicit SceneHandle(Scene scene) : scene_(std::move(scene)) {}

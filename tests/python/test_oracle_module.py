@@ -45,6 +45,25 @@ def test_rays_along_the_axes(box, backend):
     assert not box.occluded(o, d, tfar=np.float32(0.5) * r["t"], backend=backend).any()
 
 
+@pytest.mark.parametrize("backend", ["embree", "bvh"])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_moved_scene_speaks_user_coordinates(box, backend, dtype):
+    # Moved by 1e5 the scene is traced next to the origin (finalize rebases it), but
+    # positions, bounds and ray origins stay in the user's coordinates, exactly.
+    shift = np.float32([1e5, -3e4, 7e4])
+    moved = pathbench.load_scene("paper-cornell", offset=tuple(float(x) for x in shift))
+    assert np.array_equal(moved.positions, box.positions + shift)
+    assert not moved.positions.flags.writeable
+    assert np.array_equal(moved.bounds, box.bounds + shift)
+    o = np.zeros((3, 3), dtype) + shift.astype(dtype)
+    d = np.eye(3, dtype=dtype) * dtype(2)
+    r = moved.intersect(o, d, backend=backend)
+    ref = box.intersect(np.zeros((3, 3), np.float32), d.astype(np.float32), backend=backend)
+    assert r["hit"].all() and np.array_equal(r["prim"], ref["prim"])
+    assert np.allclose(r["t"], ref["t"], rtol=1e-6)
+    assert moved.occluded(o, d, backend=backend).all()
+
+
 @pytest.mark.parametrize("call, message", [
     (lambda s: s.intersect(np.zeros((2, 2)), np.ones((2, 2))), "shape (N, 3)"),
     (lambda s: s.intersect(np.zeros((2, 3)), np.ones((3, 3))), "same number of rows"),

@@ -45,6 +45,31 @@ inline Image load_reference(const std::string& stem, uint32_t size) {
   return r;
 }
 
+// The reference at half its resolution: each pixel the mean of a 2 x 2 block (the box
+// pixel filter makes that exactly the half-size image's pixel), its variance the sum of
+// the four variances / 16. Lets fast tests render at 128 x 128 against a 256 x 256 one.
+inline Image half_resolution(const Image& full, uint32_t full_size) {
+  const uint32_t half = full_size / 2;
+  Image r;
+  r.spp = full.spp * 4;  // samples behind each half-size pixel
+  r.mean.assign(size_t(half) * half * 3, 0.0f);
+  r.var.assign(r.mean.size(), 0.0f);
+  for (uint32_t y = 0; y < half; ++y)
+    for (uint32_t x = 0; x < half; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double m = 0, v = 0;
+        for (uint32_t k = 0; k < 4; ++k) {
+          const size_t i = ((size_t(2 * y + k / 2) * full_size) + 2 * x + k % 2) * 3 + c;
+          m += full.mean[i];
+          v += full.var[i];
+        }
+        const size_t o = (size_t(y) * half + x) * 3 + c;
+        r.mean[o] = float(m / 4);
+        r.var[o] = float(v / 16);
+      }
+  return r;
+}
+
 // A CPU render of `s` (variance on, no progress bar) that must discard no sample.
 inline Image render_with_variance(const Scene& scene, RenderSettings s) {
   s.variance = true;

@@ -79,13 +79,30 @@ struct Scene {
   SceneFeatures features;
   RayOffset offset{};
   uint32_t dropped_triangles = 0;
+  // Where the traced coordinates sit in the user's: user = positions + origin (the camera
+  // and bounds too). Zero unless finalize() moved a scene lying far from the origin next
+  // to it (scene_origin.cpp); what a user reads back (Python's positions, bounds, rays)
+  // adds it back. The tracers never see it.
+  Vec3f origin{0, 0, 0};
+  // Below this many float32 steps (at its largest coordinate) across its extent, a
+  // scene's input was rounded visibly: finalize() warns.
+  static constexpr double kMinFloatStepsAcross = 4096;
 
   // Validates (finite coordinates, indices in range, materials sane), drops
   // zero-area triangles with a warning on stderr, and builds the emitter table,
-  // bounds, features and ray offsets. Throws InputError naming `name`.
+  // bounds, features and ray offsets; a scene far from the origin is moved next to it
+  // (origin). Throws InputError naming `name`.
   void finalize();
   SceneView view() const;
   float max_emission() const;
+
+ private:
+  void rebase_far_from_origin();  // part of finalize()
 };
+
+// The scene with every point p (user coordinates) moved to p * scale + offset, the
+// camera too, then finalized again (bounds, offsets and origin follow). Throws
+// InputError for a scale that is not finite and positive or an offset that is not finite.
+Scene transformed(Scene s, float scale, Vec3f offset);
 
 }  // namespace pb
