@@ -59,6 +59,39 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
   return Vec3f(st.L);
 }
 
+// Whether the batched samples' closest-hit and shadow rays go to Embree as one packet of
+// the batch's width (rtcIntersect8/16, rtcOccluded8/16) instead of one rtcIntersect1 /
+// rtcOccluded1 each (notes/cpu-performance.md measures both).
+constexpr bool kPixelPackets = true;
+
+// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet.
+template <int W>
+void closest_packet(const EmbreeScene& e, RTCIntersectContext& ctx, const PathState<float>* st, const int* idx, int n,
+                    uint32_t* prim) {
+  alignas(64) RTCRayHitNt<W> p;
+  alignas(64) int valid[W];
+  for (int j = 0; j < W; ++j) {
+    valid[j] = j < n ? -1 : 0;
+    set_lane(p.ray, j, st[idx[j < n ? j : 0]].ray, kInfinity);
+    p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+  }
+  intersect_packet(valid, e.handle(), &ctx, p);
+  for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
+}
+// Whether each shadow ray q[idx[0..n)] (n <= W) is blocked, as one packet.
+template <int W>
+void occluded_packet_of(const EmbreeScene& e, RTCIntersectContext& ctx, const ShadowQuery<float>* q, const int* idx,
+                        int n, bool* blocked) {
+  alignas(64) RTCRayNt<W> p;
+  alignas(64) int valid[W];
+  for (int j = 0; j < W; ++j) {
+    valid[j] = j < n ? -1 : 0;
+    set_lane(p, j, q[idx[j < n ? j : 0]].ray, 1.0f);
+  }
+  occluded_packet(valid, e.handle(), &ctx, p);
+  for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
+}
+
 // Diffuse-only float renders with a vector ISA (batched_shading_table): up to k.lanes
 // samples of one pixel at a time, each traced as its own path with single rays
 // (rtcIntersect1 / rtcOccluded1, in trace_path's order), their path steps run together
@@ -108,12 +141,17 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
       }
     }
     if (n_live == 0) break;
-    // Closest hits, one ray at a time; misses end their paths.
+    // Closest hits (one packet, or one ray at a time); misses end their paths.
+    uint32_t hit[kMaxShadeLanes];
+    if (kPixelPackets) {
+      if (width == 16) closest_packet<16>(job.embree, ctx, st, live, n_live, hit);
+      else closest_packet<8>(job.embree, ctx, st, live, n_live, hit);
+    }
     ShadeBatch batch;
     batch.lanes = 0;
     for (int j = 0; j < n_live; ++j) {
       const int i = live[j];
-      const uint32_t prim = closest_triangle(job.embree, ctx, st[i].ray);
+      const uint32_t prim = kPixelPackets ? hit[j] : closest_triangle(job.embree, ctx, st[i].ray);
       count_ray(local.rays, st[i].depth, &RayCounts::bounce);
       if (prim == RTC_INVALID_GEOMETRY_ID) continue;
       batch.st[batch.lanes] = &st[i];
@@ -130,10 +168,25 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     }
     k.shade_diffuse(job.scene, job.config, table, batch);
     keep = 0;
+    int shadowed[kMaxShadeLanes], n_shadowed = 0;
     for (int j = 0; j < n_live; ++j) {
       const int i = live[j];
-      if (batch.wants_shadow[j]) occlusion_test(i, &RayCounts::shadow);
+      if (batch.wants_shadow[j]) {
+        if (kPixelPackets) {
+          count_ray(local.rays, st[i].depth, &RayCounts::shadow);
+          shadowed[n_shadowed++] = i;
+        } else {
+          occlusion_test(i, &RayCounts::shadow);
+        }
+      }
       if (batch.cont[j]) live[keep++] = i;
+    }
+    if (n_shadowed > 0) {
+      bool blocked[kMaxShadeLanes];
+      if (width == 16) occluded_packet_of<16>(job.embree, ctx, q, shadowed, n_shadowed, blocked);
+      else occluded_packet_of<8>(job.embree, ctx, q, shadowed, n_shadowed, blocked);
+      for (int j = 0; j < n_shadowed; ++j)
+        if (!blocked[j]) shadow_unoccluded(st[shadowed[j]], q[shadowed[j]]);
     }
     n_live = keep;
   }

@@ -38,18 +38,7 @@ namespace {
 // AVX-512 (Embree's AVX-512 kernels trace 16 natively), 8 with AVX2 and for the scalar
 // path step. (Measured with callgrind on an AVX2 machine: 16-wide packets ran through
 // the same Embree kernel at the same instruction count there.)
-inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<8>& p) {
-  rtcIntersect8(valid, s, c, reinterpret_cast<RTCRayHit8*>(&p));
-}
-inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<16>& p) {
-  rtcIntersect16(valid, s, c, reinterpret_cast<RTCRayHit16*>(&p));
-}
-inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<8>& p) {
-  rtcOccluded8(valid, s, c, reinterpret_cast<RTCRay8*>(&p));
-}
-inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<16>& p) {
-  rtcOccluded16(valid, s, c, reinterpret_cast<RTCRay16*>(&p));
-}
+// (intersect_packet, occluded_packet: embree_rays.h.)
 
 // Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
 // are neighbours on the image (coherent camera rays).
@@ -185,17 +174,6 @@ PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, const BatchKernels* 
   pool.live.resize(keep);
 }
 
-// Packet fields that stay as set: everything but the ray, tfar and the hit.
-template <int W> void init_packet_constants(RTCRayNt<W>& r) {
-  for (int i = 0; i < W; ++i) {
-    r.tnear[i] = 0.0f;
-    r.time[i] = 0.0f;
-    r.mask[i] = 0xFFFFFFFFu;
-    r.id[i] = 0;
-    r.flags[i] = 0;
-  }
-}
-
 // The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
 // are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W);
 // false (nothing done) without kernels or for double records, which the caller
@@ -237,10 +215,7 @@ void stage_intersect(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& p
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
     }
     intersect_packet(valid, job.embree.handle(), &ctx, packet);
-    for (int i = 0; i < n; ++i)
-      pool.prim[slots[i]] = packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID
-                                ? RTC_INVALID_GEOMETRY_ID
-                                : job.embree.triangle(packet.hit.primID[i], packet.hit.u[i], packet.hit.v[i]);
+    for (int i = 0; i < n; ++i) pool.prim[slots[i]] = packet_triangle(job.embree, packet, i);
   }
 }
 
