@@ -4,17 +4,6 @@
 #define PB_SIMD_NS avx512
 #define PB_SIMD_LANES 16
 #define PB_SIMD_TARGET "avx512f,avx512bw,avx512dq,avx512vl"
+#define PB_SIMD_ISA Avx512
+#define PB_SIMD_KERNELS avx512_kernels
 #include "shade_kernels.inc"
-
-namespace pb::cpu {
-const BatchKernels& avx512_kernels() {
-  static const BatchKernels k{Isa::Avx512,
-                              avx512::kLanes,
-                              avx512::begin_paths_k,
-                              avx512::final_vertex_candidates_k,
-                              avx512::shade_diffuse_k,
-                              avx512::rays_to_packet_k,
-                              avx512::sincos_turns_k};
-  return k;
-}
-}  // namespace pb::cpu
