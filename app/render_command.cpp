@@ -26,6 +26,10 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--embree-layout", o.embree_layout,
                  "CPU: triangles to Embree as they are, paired into quads, or auto (measured per scene)")
       ->capture_default_str();
+  cmd.add_option("--isa", o.isa,
+                 "CPU: instruction set of the batched path step: auto (widest the CPU has), avx512, avx2 or scalar; "
+                 "same image with each")
+      ->capture_default_str();
   cmd.add_option("--sampling", o.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
   cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
   cmd.add_option("--strategy", o.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
@@ -45,6 +49,7 @@ void finish_render_options(RenderOptions& o) {
   o.settings.device = parse_device(o.device);
   o.settings.precision = parse_precision(o.precision);
   o.settings.embree_layout = parse_embree_layout(o.embree_layout);
+  o.settings.isa = parse_isa(o.isa);
   if (o.converged) {
     o.settings.max_bounces = -1;
     o.settings.russian_roulette = true;

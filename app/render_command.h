@@ -17,6 +17,7 @@ struct RenderOptions {
   RenderSettings settings;
   std::string sampling = "nee", strategy = "pixel", device = "cpu", precision = "float";
   std::string embree_layout = "auto";
+  std::string isa = "auto";
   bool converged = false;
   std::string out, report, variance_out;
   bool profile = false;

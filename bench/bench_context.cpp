@@ -3,7 +3,7 @@
 #include <benchmark/benchmark.h>
 #include <embree3/rtcore_config.h>
 #include <fmt/chrono.h>
-#include <fmt/core.h>
+#include <fmt/format.h>
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "pathbench/common/report.h"
+#include "pathbench/cpu/isa.h"
 
 #if PATHBENCH_BENCH_GPU
 #include "pathbench/gpu/render.h"
@@ -70,6 +71,7 @@ void add_environment_context(const std::string& preset) {
   add("cxx_flags", PATHBENCH_BENCH_CXX_FLAGS);
   add("build_type", PATHBENCH_BENCH_BUILD_TYPE);
   add("embree_version", RTC_VERSION_STRING);
+  add("cpu_vector_flags", fmt::format("{}", fmt::join(cpu::cpu_vector_flags(), " ")));  // which --isa can run
   // A copy of the tree without .git (a GPU host) has no revision of its own; the
   // copier may name the source commit in PATHBENCH_SOURCE_COMMIT.
   std::string rev = git_revision();

@@ -80,10 +80,12 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   state.counters["pixels_x_spp"] = double(s.total_samples());
   state.counters["triangles"] = double(scene->triangles.size());
   state.counters["threads"] = double(last.threads);
-  // Which Embree layout the CPU traced (auto decides per scene and process): a change of
-  // layout between two runs shows here, not only as a change of speed.
+  // Which Embree layout the CPU traced (auto decides per scene and process) and which
+  // instruction set its path step ran (--isa auto: the widest the CPU has): a change of
+  // either between two runs shows here, not only as a change of speed.
   if (last.extra.contains("embree_layout"))
-    state.SetLabel("embree_layout=" + last.extra["embree_layout"]["used"].get<std::string>());
+    state.SetLabel("embree_layout=" + last.extra["embree_layout"]["used"].get<std::string>() +
+                   (last.extra.contains("isa") ? " isa=" + last.extra["isa"].get<std::string>() : ""));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 # instructions/sample".
 # Usage: scripts/cpu_instructions.sh [build-dir] [keep-dir]  (keep-dir: keep callgrind.out.* for
 # callgrind_annotate). Needs valgrind and a built <build-dir>/bin/pathbench.
+# ISA=avx2|scalar pins `--isa` (valgrind 3.19 runs no AVX-512: under it, auto means avx2).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -23,7 +24,7 @@ for strategy in pixel wavefront; do
     out=$tmp/callgrind.out.$strategy.$layout
     valgrind --tool=callgrind --callgrind-out-file="$out" --toggle-collect="${toggle[$strategy]}" "$exe" render \
       --scene paper-cornell --width $w --height $w --spp $spp --bounces 2 --sampling nee --threads 1 \
-      --strategy "$strategy" --embree-layout $layout --quiet --out "$tmp/image.pfm" >/dev/null 2>"$tmp/cg.err"
+      --strategy "$strategy" --embree-layout $layout ${ISA:+--isa $ISA} --quiet --out "$tmp/image.pfm" >/dev/null 2>"$tmp/cg.err"
     ir=$(awk '/^summary:/ {print $2}' "$out")
     echo "$strategy/$layout $ir $(awk -v i="$ir" -v n=$((w * w * spp)) 'BEGIN {printf "%.1f", i / n}')"
     [[ -n $keep ]] && cp "$out" "$keep/"

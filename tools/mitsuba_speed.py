@@ -9,7 +9,9 @@ max_depth = 3; pathbench: --bounces 2 --sampling nee), box filter, all hardware
 threads. Mitsuba 3 runs its llvm_ad_rgb variant (needs libLLVM: apt-get install
 libllvm19); one warm-up render (JIT compilation) is excluded, then --repeats renders
 are timed and the median is reported. pathbench runs `pathbench render ... --strategy
-pixel|wavefront --report` --repeats times each, median of its own reported seconds.
+pixel|wavefront --report` --repeats times each, median of its own reported seconds;
+with `--isa avx512,avx2,...` each strategy once per instruction set of the batched path
+step (`pathbench render --isa`), so one run compares them on this host.
 The runs go in rounds (Mitsuba, pixel, wavefront; again), so load that comes and goes
 during the run is shared out evenly.
 
@@ -23,7 +25,8 @@ strategy's rays/s is set against Embree's raw rate for the render's own ray mix
 robust Embree scene).
 
 Writes results/<machine>/mitsuba-vs-pathbench.json and .md, <machine> being the slug
-pb::machine_slug gives (tools/machine.py).
+pb::machine_slug gives (tools/machine.py), with the CPU's vector flags (which ISAs this
+host has) and the ISA each pathbench run used.
 """
 from __future__ import annotations
 
@@ -42,7 +45,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mitsuba_scene as ms  # noqa: E402
 import raw_embree_mix  # noqa: E402
-from machine import cpu_model, machine_slug  # noqa: E402
+from machine import cpu_model, cpu_vector_flags, machine_slug  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -102,11 +105,13 @@ FULL_TRACE_RAYS_PER_SAMPLE = 4.504
 
 class PathbenchRunner:
     """`pathbench render` on paper-cornell with one strategy; its own report's seconds.
-    `spec` is a strategy, optionally with flags after '/': "wavefront/no-watertight"."""
+    `spec` is a strategy, optionally with flags after '/': "wavefront/no-watertight",
+    "pixel/isa=avx2" (an option with its value)."""
 
     def __init__(self, binary, spec, spp, size, tmp):
         self.strategy, *flags = spec.split("/")
-        self.flags = [f"--{f}" for f in flags]
+        self.flags = [x for f in flags for x in (f"--{f}".split("=", 1))]
+        self.watertight = "no-watertight" not in flags
         self.label = spec
         self.binary, self.spp, self.size, self.tmp = binary, spp, size, Path(tmp)
         self.runs = []
@@ -144,6 +149,8 @@ class PathbenchRunner:
             "peak_host_bytes": med.get("peak_host_bytes"),
             "image_mean_rgb": med["image_mean_rgb"],
             "embree_layout": med.get("embree_layout"),  # the report's: asked, used, why, probe times
+            "isa": med.get("isa"),  # the path step's instruction set, as the report names it
+            "isa_asked": med.get("isa_asked"),
         }
 
 
@@ -176,6 +183,10 @@ def markdown(res):
         f"{res['machine']['hardware_threads']} hardware threads, measured {res['date']} "
         f"(load average before {res['load_average_before']}, after {res['load_average_after']}).",
     ]
+    flags = res["machine"].get("cpu_flags")
+    if flags is not None:
+        lines += ["", "CPU vector flags: " + (" ".join(flags) or "none beyond SSE2") + "; pathbench's path step ran "
+                  + ", ".join(f"{s}: {r.get('isa') or '?'}" for s, r in pb.items()) + "."]
     # Only the load before the run says whether something else was running: during it,
     # the renderers' own threads raise the load average to about the thread count.
     load = res["load_average_before"][0] if res["load_average_before"] else 0
@@ -201,7 +212,7 @@ def markdown(res):
         lines += ["", "Against Embree's raw ray-cast rate for each render's own ray mix (camera rays as coherent "
                   "closest hits, bounce rays as incoherent closest hits, shadow rays as incoherent occlusion rays; "
                   "pathbench-bench raycast benchmarks on this scene, run once per round, medians; aim: 80%):", "",
-                  "| strategy | rays by kind (camera / bounce / shadow) | Embree calls | raw rate, same mix | "
+                  "| run | rays by kind (camera / bounce / shadow) | Embree calls | raw rate, same mix | "
                   "pathbench rays/s | share of raw |", "|---|---|---|---:|---:|---:|"]
         for strategy, m_ in raw["mix"].items():
             r = pb[strategy]
@@ -239,14 +250,21 @@ def main(argv=None):
     ap.add_argument("--strategies", default="pixel,wavefront,pixel/no-watertight,wavefront/no-watertight",
                     help="strategies, each optionally with flags after '/' (default: both, watertight or not)")
     ap.add_argument("--out-dir", help="default: results/<machine>")
+    ap.add_argument("--isa", default="",
+                    help="comma list of `pathbench render --isa` values (auto, avx512, avx2, scalar): each strategy "
+                         "once per ISA (default: the binary's own choice, auto)")
     ap.add_argument("--no-raw", action="store_true", help="skip the raw Embree ray casts (pathbench-bench)")
     a = ap.parse_args(argv)
+    specs = [s for s in a.strategies.split(",")]
+    if a.isa:
+        specs = [f"{s}/isa={i}" for s in specs for i in a.isa.split(",")]
     if not Path(a.pathbench).is_file():
         sys.exit(f"{a.pathbench}: not built (run scripts/build.sh, or pass --pathbench)")
 
     res = {
         "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "machine": {"slug": machine_slug(), "cpu": cpu_model(), "hardware_threads": os.cpu_count()},
+        "machine": {"slug": machine_slug(), "cpu": cpu_model(), "hardware_threads": os.cpu_count(),
+                    "cpu_flags": cpu_vector_flags()},
         "settings": {"scene": "paper-cornell", "width": a.size, "height": a.size, "spp": a.spp, "bounces": 2,
                      "sampling": "nee", "filter": "box", "repeats": a.repeats},
         "load_average_before": loadavg(),
@@ -257,7 +275,7 @@ def main(argv=None):
     raw_rounds = []
     with tempfile.TemporaryDirectory() as tmp:
         mitsuba = MitsubaRunner(a.spp, a.variant, a.size)
-        ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp) for s in a.strategies.split(",")}
+        ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp) for s in specs}
         for _ in range(a.repeats):
             mitsuba.run()
             for r in ours.values():
@@ -272,10 +290,12 @@ def main(argv=None):
         rates = raw_embree_mix.median_rates(raw_rounds)
         res["raw_embree"] = {"rates": rates, "rounds": len(raw_rounds), "mix": {}}
         for s, r in res["pathbench"].items():
-            if s in raw_embree_mix.WIDTH:  # watertight strategies (no flags)
-                raw = raw_embree_mix.mix_rate(r["rays"], rates, s)
+            if ours[s].watertight and ours[s].strategy in raw_embree_mix.WIDTH:  # the benchmarks are robust mode
+                strategy = ours[s].strategy
+                raw = raw_embree_mix.mix_rate(r["rays"], rates, strategy)
                 res["raw_embree"]["mix"][s] = {
-                    "calls": "rtcIntersect1 / rtcOccluded1" if s == "pixel" else "16-wide packets",
+                    "calls": "rtcIntersect1 / rtcOccluded1" if strategy == "pixel" else "16-wide packets",
+                    "isa": r.get("isa"),
                     "raw_rays_per_second": round(raw), "share": round(r["median_rays_per_second"] / raw, 4)}
     res["load_average_after"] = loadavg()
 

@@ -32,6 +32,15 @@ const char* to_string(EmbreeLayout l) {
   }
   return "?";
 }
+const char* to_string(Isa i) {
+  switch (i) {
+    case Isa::Auto: return "auto";
+    case Isa::Avx512: return "avx512";
+    case Isa::Avx2: return "avx2";
+    case Isa::Scalar: return "scalar";
+  }
+  return "?";
+}
 
 Sampling parse_sampling(std::string_view s) {
   if (s == "uniform") return Sampling::Uniform;
@@ -61,6 +70,14 @@ EmbreeLayout parse_embree_layout(std::string_view s) {
   if (s == "triangles") return EmbreeLayout::Triangles;
   if (s == "quads") return EmbreeLayout::Quads;
   throw InputError(fmt::format("--embree-layout: unknown layout '{}' (expected auto, triangles or quads)", s));
+}
+
+Isa parse_isa(std::string_view s) {
+  if (s == "auto") return Isa::Auto;
+  if (s == "avx512") return Isa::Avx512;
+  if (s == "avx2") return Isa::Avx2;
+  if (s == "scalar") return Isa::Scalar;
+  throw InputError(fmt::format("--isa: unknown instruction set '{}' (expected auto, avx512, avx2 or scalar)", s));
 }
 
 void RenderSettings::validate() const {

@@ -52,4 +52,35 @@ template <class T> inline bool occluded(const EmbreeScene& e, RTCIntersectContex
   return sr.tfar < 0.0f;  // Embree marks an occluded ray with tfar = -inf
 }
 
+// Packets of 8 or 16 rays (the batched path step's widths: AVX2, AVX-512).
+inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<8>& p) {
+  rtcIntersect8(valid, s, c, reinterpret_cast<RTCRayHit8*>(&p));
+}
+inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<16>& p) {
+  rtcIntersect16(valid, s, c, reinterpret_cast<RTCRayHit16*>(&p));
+}
+inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<8>& p) {
+  rtcOccluded8(valid, s, c, reinterpret_cast<RTCRay8*>(&p));
+}
+inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<16>& p) {
+  rtcOccluded16(valid, s, c, reinterpret_cast<RTCRay16*>(&p));
+}
+
+// Packet fields that stay as set: everything but the ray, tfar and the hit.
+template <int W> void init_packet_constants(RTCRayNt<W>& r) {
+  for (int i = 0; i < W; ++i) {
+    r.tnear[i] = 0.0f;
+    r.time[i] = 0.0f;
+    r.mask[i] = 0xFFFFFFFFu;
+    r.id[i] = 0;
+    r.flags[i] = 0;
+  }
+}
+
+// The scene triangle a packet's lane i hit (after intersect_packet), or RTC_INVALID_GEOMETRY_ID.
+template <int W> inline uint32_t packet_triangle(const EmbreeScene& e, const RTCRayHitNt<W>& p, int i) {
+  return p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID
+                                                    : e.triangle(p.hit.primID[i], p.hit.u[i], p.hit.v[i]);
+}
+
 }  // namespace pb::cpu

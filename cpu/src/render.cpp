@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "pathbench/cpu/embree_scene.h"
+#include "pathbench/cpu/isa.h"
 #include "pathbench/common/errors.h"
 #include "strategies.h"
 
@@ -21,6 +22,7 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
     throw InputError("--strategy paper-queue: the paper's global queue is a GPU strategy; the CPU runs pixel or wavefront");
   if (film.width() != settings.width || film.height() != settings.height)
     throw std::logic_error("film size does not match the settings");
+  const Isa isa = resolve_isa(settings.isa);  // InputError where the CPU lacks the asked ISA
 
   std::unique_ptr<tbb::global_control> limit;
   if (settings.threads > 0)
@@ -31,7 +33,7 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   film.begin(settings.spp, scene.max_emission());
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
                     settings.total_samples(), settings.progress);
-  TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress};
+  TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress, isa};
 
   const auto t0 = std::chrono::steady_clock::now();
   const uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads);
@@ -66,6 +68,11 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
                                    {"probe_ns_per_ray", nullptr}};
   if (layout.triangles_ns > 0)
     report.extra["embree_layout"]["probe_ns_per_ray"] = {{"triangles", layout.triangles_ns}, {"quads", layout.quads_ns}};
+  // The ISA the path step ran with (scalar where the batched one does not apply:
+  // double, other materials, big scenes), the one asked, and what the CPU offers.
+  report.extra["isa"] = to_string(totals.isa);
+  report.extra["isa_asked"] = to_string(settings.isa);
+  report.extra["cpu_flags"] = cpu_vector_flags();
   report.extra["film_bytes"] = film.bytes();
   report.extra["pool_bytes"] = totals.pool_bytes;
   report.extra["shade_table_bytes"] = totals.table_bytes;

@@ -3,8 +3,9 @@
 // render_pixel_all_kinds.cpp. The diffuse-only code is then compiled exactly as in a
 // build without the other kinds (the compiler's inlining budget is per translation unit).
 // Every sample is one path traced with single rays (rtcIntersect1 / rtcOccluded1); for
-// diffuse-only float renders on AVX2 CPUs the path steps of up to eight samples of a
-// pixel run together, eight lanes wide (trace_samples_x8), bit-identical to trace_path.
+// diffuse-only float renders with a vector ISA (--isa) the path steps of up to 16
+// (AVX-512) or 8 (AVX2) samples of a pixel run together, a vector wide
+// (trace_samples_batched), bit-identical to trace_path.
 #include <tbb/blocked_range2d.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
@@ -16,8 +17,6 @@
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
 #include "strategies.h"
-
-#include "shade_x8_avx2.h"  // avx2::, the batched path step
 
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly
@@ -60,32 +59,67 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
   return Vec3f(st.L);
 }
 
-// Diffuse-only float renders on AVX2 CPUs (batched_shading_table): up to eight samples of
-// one pixel at a time, each traced as its own path with single rays (rtcIntersect1 /
-// rtcOccluded1, in trace_path's order), their path steps run together eight lanes wide
-// (shade_x8.h). Every path gets what trace_path would give it, bit for bit.
-PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& table, RTCIntersectContext& ctx, uint32_t pixel,
-                                     uint32_t first_sample, int count, Local& local) {
-  alignas(64) PathState<float> st[kShadeLanes];
-  ShadowQuery<float> q[kShadeLanes];
-  PathState<float>* lanes[kShadeLanes];
-  uint32_t pixels[kShadeLanes], samples[kShadeLanes];
-  for (int i = 0; i < kShadeLanes; ++i) {
+// Whether the batched samples' closest-hit and shadow rays go to Embree as one packet of
+// the batch's width (rtcIntersect8/16, rtcOccluded8/16) instead of one rtcIntersect1 /
+// rtcOccluded1 each (notes/cpu-performance.md measures both).
+constexpr bool kPixelPackets = true;
+
+// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet.
+template <int W>
+void closest_packet(const EmbreeScene& e, RTCIntersectContext& ctx, const PathState<float>* st, const int* idx, int n,
+                    uint32_t* prim) {
+  alignas(64) RTCRayHitNt<W> p;
+  alignas(64) int valid[W];
+  for (int j = 0; j < W; ++j) {
+    valid[j] = j < n ? -1 : 0;
+    set_lane(p.ray, j, st[idx[j < n ? j : 0]].ray, kInfinity);
+    p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+  }
+  intersect_packet(valid, e.handle(), &ctx, p);
+  for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
+}
+// Whether each shadow ray q[idx[0..n)] (n <= W) is blocked, as one packet.
+template <int W>
+void occluded_packet_of(const EmbreeScene& e, RTCIntersectContext& ctx, const ShadowQuery<float>* q, const int* idx,
+                        int n, bool* blocked) {
+  alignas(64) RTCRayNt<W> p;
+  alignas(64) int valid[W];
+  for (int j = 0; j < W; ++j) {
+    valid[j] = j < n ? -1 : 0;
+    set_lane(p, j, q[idx[j < n ? j : 0]].ray, 1.0f);
+  }
+  occluded_packet(valid, e.handle(), &ctx, p);
+  for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
+}
+
+// Diffuse-only float renders with a vector ISA (batched_shading_table): up to k.lanes
+// samples of one pixel at a time, each traced as its own path with single rays
+// (rtcIntersect1 / rtcOccluded1, in trace_path's order), their path steps run together
+// k.lanes wide (shade_x8.h). Every path gets what trace_path would give it, bit for bit.
+PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table,
+                                          RTCIntersectContext& ctx, uint32_t pixel, uint32_t first_sample, int count,
+                                          Local& local) {
+  const int width = k.lanes;
+  alignas(64) PathState<float> st[kMaxShadeLanes];
+  ShadowQuery<float> q[kMaxShadeLanes];
+  PathState<float>* lanes[kMaxShadeLanes];
+  uint32_t pixels[kMaxShadeLanes], samples[kMaxShadeLanes];
+  for (int i = 0; i < width; ++i) {
     lanes[i] = &st[i < count ? i : 0];
     pixels[i] = pixel;
     samples[i] = first_sample + uint32_t(i < count ? i : 0);
   }
-  avx2::begin_paths_x8(job.scene, job.config, pixels, samples, lanes, count);
+  k.begin_paths(job.scene, job.config, pixels, samples, lanes, count);
   auto occlusion_test = [&](int i, uint64_t RayCounts::*kind) {
     count_ray(local.rays, st[i].depth, kind);
     if (!occluded(job.embree, ctx, q[i].ray, 1.0f)) shadow_unoccluded(st[i], q[i]);
   };
-  int live[kShadeLanes], n_live = count;
+  int live[kMaxShadeLanes], n_live = count;
   for (int i = 0; i < count; ++i) live[i] = i;
   while (n_live > 0) {
     // Paths at their last vertex: the emitter screen, then path_final_query (trace_path's first step).
-    PathState<float>* at_final[kShadeLanes];
-    int final_lane[kShadeLanes], n_final = 0, keep = 0;
+    PathState<float>* at_final[kMaxShadeLanes];
+    int final_lane[kMaxShadeLanes], n_final = 0, keep = 0;
     for (int k = 0; k < n_live; ++k) {
       const int i = live[k];
       if (path_at_final_vertex(job.scene, job.config, st[i])) {
@@ -97,22 +131,27 @@ PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& tabl
     }
     n_live = keep;
     if (n_final > 0) {
-      for (int k = n_final; k < kShadeLanes; ++k) at_final[k] = at_final[0];
-      bool candidate[kShadeLanes];
-      avx2::final_vertex_candidates_x8(job.scene, at_final, candidate);
-      for (int k = 0; k < n_final; ++k) {
-        const int i = final_lane[k];
-        if (candidate[k] && path_final_query<kDiffuseOnly>(job.scene, job.config, st[i], q[i]))
+      for (int j = n_final; j < width; ++j) at_final[j] = at_final[0];
+      bool candidate[kMaxShadeLanes];
+      k.final_vertex_candidates(job.scene, at_final, candidate);
+      for (int j = 0; j < n_final; ++j) {
+        const int i = final_lane[j];
+        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, st[i], q[i]))
           occlusion_test(i, &RayCounts::shadow);
       }
     }
     if (n_live == 0) break;
-    // Closest hits, one ray at a time; misses end their paths.
-    Shade8 batch;
+    // Closest hits (one packet, or one ray at a time); misses end their paths.
+    uint32_t hit[kMaxShadeLanes];
+    if (kPixelPackets) {
+      if (width == 16) closest_packet<16>(job.embree, ctx, st, live, n_live, hit);
+      else closest_packet<8>(job.embree, ctx, st, live, n_live, hit);
+    }
+    ShadeBatch batch;
     batch.lanes = 0;
-    for (int k = 0; k < n_live; ++k) {
-      const int i = live[k];
-      const uint32_t prim = closest_triangle(job.embree, ctx, st[i].ray);
+    for (int j = 0; j < n_live; ++j) {
+      const int i = live[j];
+      const uint32_t prim = kPixelPackets ? hit[j] : closest_triangle(job.embree, ctx, st[i].ray);
       count_ray(local.rays, st[i].depth, &RayCounts::bounce);
       if (prim == RTC_INVALID_GEOMETRY_ID) continue;
       batch.st[batch.lanes] = &st[i];
@@ -122,17 +161,32 @@ PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& tabl
     }
     n_live = batch.lanes;
     if (n_live == 0) break;
-    for (int k = n_live; k < kShadeLanes; ++k) {
-      batch.st[k] = batch.st[0];
-      batch.shadow[k] = batch.shadow[0];
-      batch.prim[k] = batch.prim[0];
+    for (int j = n_live; j < width; ++j) {
+      batch.st[j] = batch.st[0];
+      batch.shadow[j] = batch.shadow[0];
+      batch.prim[j] = batch.prim[0];
     }
-    avx2::shade_diffuse_x8(job.scene, job.config, table, batch);
+    k.shade_diffuse(job.scene, job.config, table, batch);
     keep = 0;
-    for (int k = 0; k < n_live; ++k) {
-      const int i = live[k];
-      if (batch.wants_shadow[k]) occlusion_test(i, &RayCounts::shadow);
-      if (batch.cont[k]) live[keep++] = i;
+    int shadowed[kMaxShadeLanes], n_shadowed = 0;
+    for (int j = 0; j < n_live; ++j) {
+      const int i = live[j];
+      if (batch.wants_shadow[j]) {
+        if (kPixelPackets) {
+          count_ray(local.rays, st[i].depth, &RayCounts::shadow);
+          shadowed[n_shadowed++] = i;
+        } else {
+          occlusion_test(i, &RayCounts::shadow);
+        }
+      }
+      if (batch.cont[j]) live[keep++] = i;
+    }
+    if (n_shadowed > 0) {
+      bool blocked[kMaxShadeLanes];
+      if (width == 16) occluded_packet_of<16>(job.embree, ctx, q, shadowed, n_shadowed, blocked);
+      else occluded_packet_of<8>(job.embree, ctx, q, shadowed, n_shadowed, blocked);
+      for (int j = 0; j < n_shadowed; ++j)
+        if (!blocked[j]) shadow_unoccluded(st[shadowed[j]], q[shadowed[j]]);
     }
     n_live = keep;
   }
@@ -143,7 +197,8 @@ PB_CPU_FLATTEN void trace_samples_x8(const TraceJob& job, const ShadeTable& tabl
 }
 
 template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& job) {
-  const std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene);
+  const std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene, job.isa);
+  const BatchKernels* k = table ? batch_kernels(job.isa) : nullptr;
   const uint32_t w = job.config.width, h = job.config.height;
   tbb::combinable<Local> locals;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
@@ -154,8 +209,9 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
       for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
         const uint32_t pixel = y * w + x;
         if (table) {
-          for (uint32_t s = 0; s < job.spp; s += kShadeLanes)
-            trace_samples_x8(job, *table, ctx, pixel, s, int(std::min<uint32_t>(kShadeLanes, job.spp - s)), local);
+          const uint32_t width = uint32_t(k->lanes);
+          for (uint32_t s = 0; s < job.spp; s += width)
+            trace_samples_batched(job, *k, *table, ctx, pixel, s, int(std::min<uint32_t>(width, job.spp - s)), local);
           continue;
         }
         for (uint32_t s = 0; s < job.spp; ++s) {
@@ -174,6 +230,7 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
   });
   t.state_bytes_per_path = sizeof(PathState<T>) + sizeof(ShadowQuery<T>);
   t.paths_in_flight = 0;  // one per thread, in registers and stack
+  t.isa = k ? k->isa : Isa::Scalar;
   return t;
 }
 

@@ -1,13 +1,14 @@
 // Ray-parallel ("wavefront") CPU strategy. Each thread owns a slice of the pool of
 // paths in flight and runs the stages over the whole slice in turn:
 //   generate (fill free slots with new samples) -> final vertex (paths whose next hit
-//   can only add emission: emitter query instead of a closest hit) -> intersect (8-wide
-//   packets) -> shade (shared path step) -> shadow (8-wide packets) -> accumulate
+//   can only add emission: emitter query instead of a closest hit) -> intersect (packets
+//   of W rays) -> shade (shared path step) -> shadow (packets of W) -> accumulate
 // Memory is the pool, fixed by --paths-in-flight, never width x height x spp.
-// Diffuse-only float renders on AVX2 CPUs (the paper's benchmark) run generate, final
-// vertex and shade eight paths at a time (shade_x8.h: the path step's arithmetic
-// lane-wise in its own order, so the image stays bit-identical to the pixel strategy's);
-// everything else runs the scalar path step one path at a time.
+// Diffuse-only float renders with a vector ISA (--isa; the paper's benchmark) run
+// generate, final vertex and shade a vector's width of paths at a time (BatchKernels,
+// shade_x8.h: the path step's arithmetic lane-wise in its own order, so the image stays
+// bit-identical to the pixel strategy's); everything else runs the scalar path step one
+// path at a time. Packets are 16 rays (rtcIntersect16) with AVX-512, 8 otherwise.
 // Compiled for one set of material kinds per translation unit (PB_CPU_KINDS,
 // features.h): diffuse-only here, every kind in render_wavefront_all_kinds.cpp, so the
 // diffuse-only code compiles exactly as in a build without the other kinds.
@@ -25,8 +26,6 @@
 #include "shade_batch.h"
 #include "strategies.h"
 
-#include "shade_x8_avx2.h"  // avx2::, the batched path step
-
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly
 #endif
@@ -35,17 +34,11 @@ namespace pb::cpu {
 
 namespace {
 
-// Packet width: 8, AVX2's native width. (Measured with callgrind on this AVX2 machine:
-// 16-wide packets ran through the same Embree kernel at the same instruction count.)
-constexpr int kPacket = 8;
-using PacketHit = RTCRayHit8;
-using PacketRay = RTCRay8;
-inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<kPacket>& p) {
-  rtcIntersect8(valid, s, c, reinterpret_cast<PacketHit*>(&p));
-}
-inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<kPacket>& p) {
-  rtcOccluded8(valid, s, c, reinterpret_cast<PacketRay*>(&p));
-}
+// Packet width W: the batch's width, so one batch of rays is one packet: 16 with
+// AVX-512 (Embree's AVX-512 kernels trace 16 natively), 8 with AVX2 and for the scalar
+// path step. (Measured with callgrind on an AVX2 machine: 16-wide packets ran through
+// the same Embree kernel at the same instruction count there.)
+// (intersect_packet, occluded_packet: embree_rays.h.)
 
 // Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
 // are neighbours on the image (coherent camera rays).
@@ -90,20 +83,21 @@ struct Local {
   uint64_t paths = 0, discarded = 0;
 };
 
-// With `batched` (float, AVX2) eight new paths at a time (begin_paths_x8, shade_x8.h).
+// With kernels `k` (float, a vector ISA) k->lanes new paths at a time (begin_paths).
 template <class T>
-PB_CPU_FLATTEN void stage_generate(const TraceJob& job, bool batched, SampleSource& src, PoolSlice<T>& pool) {
+PB_CPU_FLATTEN void stage_generate(const TraceJob& job, const BatchKernels* k, SampleSource& src, PoolSlice<T>& pool) {
   uint64_t n = pool.free.size();
   if (n == 0) return;
   const uint64_t start = src.claim(n);
   uint64_t i = 0;
   if constexpr (std::is_same_v<T, float>) {
-    if (batched) {
-      for (; i < n; i += kShadeLanes) {
-        const int lanes = int(std::min<uint64_t>(kShadeLanes, n - i));
-        uint32_t pixel[kShadeLanes], sample[kShadeLanes];
-        PathState<float>* st[kShadeLanes];
-        for (int l = 0; l < kShadeLanes; ++l) {
+    if (k) {
+      const int width = k->lanes;
+      for (; i < n; i += uint64_t(width)) {
+        const int lanes = int(std::min<uint64_t>(uint64_t(width), n - i));
+        uint32_t pixel[kMaxShadeLanes], sample[kMaxShadeLanes];
+        PathState<float>* st[kMaxShadeLanes];
+        for (int l = 0; l < width; ++l) {
           const uint64_t g = start + i + uint64_t(l < lanes ? l : 0);
           pixel[l] = src.pixel_of(g);
           sample[l] = src.sample_of(g);
@@ -115,7 +109,7 @@ PB_CPU_FLATTEN void stage_generate(const TraceJob& job, bool batched, SampleSour
             st[l] = st[0];
           }
         }
-        avx2::begin_paths_x8(job.scene, job.config, pixel, sample, st, lanes);
+        k->begin_paths(job.scene, job.config, pixel, sample, st, lanes);
       }
       return;
     }
@@ -130,11 +124,12 @@ PB_CPU_FLATTEN void stage_generate(const TraceJob& job, bool batched, SampleSour
 
 // Paths whose next hit could only add emitted light leave the live list here: their
 // occlusion test (if they face an emitter) joins the shadow stage, and they are done.
-// With `batched` (float, AVX2: see batched_shading_table) eight paths at a time are first
-// screened for an emitter along their ray (shade_x8.h); the scalar query runs only for
-// the lanes that may have one, and gives every path what it would have given it anyway.
+// With kernels `k` (float, a vector ISA: see batched_shading_table) k->lanes paths at a
+// time are first screened for an emitter along their ray (shade_x8.h); the scalar query
+// runs only for the lanes that may have one, and gives every path what it would have
+// given it anyway.
 template <class T, uint32_t Kinds>
-PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, bool batched, PoolSlice<T>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool, Local& local) {
   auto final_query = [&](uint32_t slot) {
     const PathState<T>& st = pool.state[slot];
     if (path_final_query<Kinds>(job.scene, job.config, st, pool.shadow[slot])) {
@@ -143,14 +138,14 @@ PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, bool batched, PoolSl
     }
     pool.done.push_back(slot);
   };
-  PathState<float>* lanes[kShadeLanes];
-  uint32_t lane_slots[kShadeLanes];
+  PathState<float>* lanes[kMaxShadeLanes];
+  uint32_t lane_slots[kMaxShadeLanes];
   int n = 0;
   auto flush = [&] {
     if constexpr (std::is_same_v<T, float>) {
-      for (int i = n; i < kShadeLanes; ++i) lanes[i] = lanes[0];
-      bool candidate[kShadeLanes];
-      avx2::final_vertex_candidates_x8(job.scene, lanes, candidate);
+      for (int i = n; i < k->lanes; ++i) lanes[i] = lanes[0];
+      bool candidate[kMaxShadeLanes];
+      k->final_vertex_candidates(job.scene, lanes, candidate);
       for (int i = 0; i < n; ++i) {
         if (candidate[i]) final_query(lane_slots[i]);
         else pool.done.push_back(lane_slots[i]);
@@ -166,10 +161,10 @@ PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, bool batched, PoolSl
       continue;
     }
     if constexpr (std::is_same_v<T, float>) {
-      if (batched) {
+      if (k) {
         lanes[n] = &pool.state[slot];
         lane_slots[n] = slot;
-        if (++n == kShadeLanes) flush();
+        if (++n == k->lanes) flush();
         continue;
       }
     }
@@ -179,43 +174,37 @@ PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, bool batched, PoolSl
   pool.live.resize(keep);
 }
 
-// Packet fields that stay as set: everything but the ray, tfar and the hit.
-template <class Ray8> void init_packet_constants(Ray8& r) {
-  for (int i = 0; i < kPacket; ++i) {
-    r.tnear[i] = 0.0f;
-    r.time[i] = 0.0f;
-    r.mask[i] = 0xFFFFFFFFu;
-    r.id[i] = 0;
-    r.flags[i] = 0;
-  }
-}
-
 // The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
-// are the ray) into a packet by one transpose (rays_to_packet_x8); false (nothing done)
-// for double records, which the caller converts lane by lane (set_lane).
-template <class Record>
-bool rays_to_packet(const std::vector<Record>& records, const uint32_t* slots, int n, RTCRayNt<kPacket>& r) {
+// are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W);
+// false (nothing done) without kernels or for double records, which the caller
+// converts lane by lane (set_lane).
+template <int W, class Record>
+bool rays_to_packet(const BatchKernels* k, const std::vector<Record>& records, const uint32_t* slots, int n,
+                    RTCRayNt<W>& r) {
   if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
-    const void* rows[kPacket];
-    for (int i = 0; i < kPacket; ++i) rows[i] = &records[slots[i < n ? i : 0]];
-    avx2::rays_to_packet_x8(rows, r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z);
+    if (!k) return false;
+    const void* rows[W];
+    for (int i = 0; i < W; ++i) rows[i] = &records[slots[i < n ? i : 0]];
+    float* const out[6] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z};
+    k->rays_to_packet(rows, out);
     return true;
   }
   return false;
 }
 
-// With `batched` (float, AVX2) each packet's rays come by one transpose (rays_to_packet)
-// instead of lane by lane.
-template <class T>
-void stage_intersect(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCIntersectContext& ctx, Local& local) {
-  alignas(64) RTCRayHitNt<kPacket> packet;
-  alignas(64) int valid[kPacket];
+// With kernels `k` (float, a vector ISA) each packet's rays come by one transpose
+// (rays_to_packet) instead of lane by lane.
+template <int W, class T>
+void stage_intersect(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool, RTCIntersectContext& ctx,
+                     Local& local) {
+  alignas(64) RTCRayHitNt<W> packet;
+  alignas(64) int valid[W];
   init_packet_constants(packet.ray);
-  for (size_t base = 0; base < pool.live.size(); base += kPacket) {
-    const int n = int(std::min<size_t>(kPacket, pool.live.size() - base));
+  for (size_t base = 0; base < pool.live.size(); base += W) {
+    const int n = int(std::min<size_t>(W, pool.live.size() - base));
     const uint32_t* slots = &pool.live[base];
-    const bool filled = batched && rays_to_packet(pool.state, slots, n, packet.ray);
-    for (int i = 0; i < kPacket; ++i) {
+    const bool filled = rays_to_packet<W>(k, pool.state, slots, n, packet.ray);
+    for (int i = 0; i < W; ++i) {
       valid[i] = i < n ? -1 : 0;
       if (i < n) {
         const PathState<T>& st = pool.state[slots[i]];
@@ -226,25 +215,23 @@ void stage_intersect(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCI
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
     }
     intersect_packet(valid, job.embree.handle(), &ctx, packet);
-    for (int i = 0; i < n; ++i)
-      pool.prim[slots[i]] = packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID
-                                ? RTC_INVALID_GEOMETRY_ID
-                                : job.embree.triangle(packet.hit.primID[i], packet.hit.u[i], packet.hit.v[i]);
+    for (int i = 0; i < n; ++i) pool.prim[slots[i]] = packet_triangle(job.embree, packet, i);
   }
 }
 
-// Diffuse-only scenes in float (the paper's case) on AVX2 CPUs: eight paths at a time
-// (shade_x8.h), bit-identical to the scalar path step below.
-PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, const ShadeTable& table, PoolSlice<float>& pool, Local& local) {
+// Diffuse-only scenes in float (the paper's case) with a vector ISA: k.lanes paths at a
+// time (shade_x8.h), bit-identical to the scalar path step below.
+PB_CPU_FLATTEN void stage_shade_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table,
+                                        PoolSlice<float>& pool, Local& local) {
   pool.next_live.clear();
-  Shade8 batch;
+  ShadeBatch batch;
   auto flush = [&] {
-    for (int i = batch.lanes; i < kShadeLanes; ++i) {  // idle lanes repeat lane 0
+    for (int i = batch.lanes; i < k.lanes; ++i) {  // idle lanes repeat lane 0
       batch.st[i] = batch.st[0];
       batch.shadow[i] = batch.shadow[0];
       batch.prim[i] = batch.prim[0];
     }
-    avx2::shade_diffuse_x8(job.scene, job.config, table, batch);
+    k.shade_diffuse(job.scene, job.config, table, batch);
     for (int i = 0; i < batch.lanes; ++i) {
       const uint32_t slot = uint32_t(batch.st[i] - pool.state.data());
       if (batch.wants_shadow[i]) {
@@ -264,18 +251,19 @@ PB_CPU_FLATTEN void stage_shade_x8(const TraceJob& job, const ShadeTable& table,
     batch.st[batch.lanes] = &pool.state[slot];
     batch.shadow[batch.lanes] = &pool.shadow[slot];
     batch.prim[batch.lanes] = pool.prim[slot];
-    if (++batch.lanes == kShadeLanes) flush();
+    if (++batch.lanes == k.lanes) flush();
   }
   if (batch.lanes > 0) flush();
   std::swap(pool.live, pool.next_live);
 }
 
-// `table`: non-null where the batched shading runs (batched_shading_table).
+// `table`: non-null where the batched shading runs (batched_shading_table), with `k`.
 template <class T, uint32_t Kinds>
-PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const ShadeTable* table, PoolSlice<T>& pool, Local& local) {
+PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const BatchKernels* k, const ShadeTable* table, PoolSlice<T>& pool,
+                                Local& local) {
   if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
     if (table) {
-      stage_shade_x8(job, *table, pool, local);
+      stage_shade_batched(job, *k, *table, pool, local);
       return;
     }
   }
@@ -299,15 +287,16 @@ PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const ShadeTable* table, Po
   std::swap(pool.live, pool.next_live);
 }
 
-template <class T> void stage_shadow(const TraceJob& job, bool batched, PoolSlice<T>& pool, RTCIntersectContext& ctx) {
-  alignas(64) RTCRayNt<kPacket> packet;
-  alignas(64) int valid[kPacket];
+template <int W, class T>
+void stage_shadow(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool, RTCIntersectContext& ctx) {
+  alignas(64) RTCRayNt<W> packet;
+  alignas(64) int valid[W];
   init_packet_constants(packet);
-  for (size_t base = 0; base < pool.shadowed.size(); base += kPacket) {
-    const int n = int(std::min<size_t>(kPacket, pool.shadowed.size() - base));
+  for (size_t base = 0; base < pool.shadowed.size(); base += W) {
+    const int n = int(std::min<size_t>(W, pool.shadowed.size() - base));
     const uint32_t* slots = &pool.shadowed[base];
-    const bool filled = batched && rays_to_packet(pool.shadow, slots, n, packet);
-    for (int i = 0; i < kPacket; ++i) {
+    const bool filled = rays_to_packet<W>(k, pool.shadow, slots, n, packet);
+    for (int i = 0; i < W; ++i) {
       valid[i] = i < n ? -1 : 0;
       if (i < n && !filled) set_lane(packet, i, pool.shadow[slots[i]].ray, 1.0f);
       packet.tfar[i] = 1.0f;
@@ -332,13 +321,15 @@ template <class T> void stage_accumulate(const TraceJob& job, PoolSlice<T>& pool
   pool.done.clear();
 }
 
-// The stages above, in scalar type T, compiled for the material kinds `Kinds` (features.h).
-template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight) {
+// The stages above, in scalar type T, compiled for the material kinds `Kinds`
+// (features.h), with packets of W rays; `k` (width W) where the batched path step runs.
+template <class T, uint32_t Kinds, int W>
+TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
+                      std::unique_ptr<ShadeTable> table) {
   const uint32_t pixels = job.config.width * job.config.height;
   SampleSource source(uint64_t(pixels) * job.spp, pixels);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
-  const uint64_t per_slice = std::max<uint64_t>(kPacket, (paths_in_flight + slices - 1) / slices);
-  const std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene);
+  const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
   tbb::combinable<Local> locals;
   tbb::parallel_for(0, slices, [&](int) {
     Local& local = locals.local();
@@ -346,12 +337,12 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (;;) {
-      stage_generate(job, table != nullptr, source, pool);
+      stage_generate(job, k, source, pool);
       if (pool.live.empty()) break;
-      stage_final_vertex<T, Kinds>(job, table != nullptr, pool, local);
-      stage_intersect(job, table != nullptr, pool, ctx, local);
-      stage_shade<T, Kinds>(job, table.get(), pool, local);
-      stage_shadow(job, table != nullptr, pool, ctx);
+      stage_final_vertex<T, Kinds>(job, k, pool, local);
+      stage_intersect<W>(job, k, pool, ctx, local);
+      stage_shade<T, Kinds>(job, k, table.get(), pool, local);
+      stage_shadow<W>(job, k, pool, ctx);
       stage_accumulate(job, pool, local);
     }
   }, tbb::static_partitioner());
@@ -365,14 +356,20 @@ template <class T, uint32_t Kinds> TraceTotals wavefront(const TraceJob& job, ui
   t.paths_in_flight = per_slice * uint64_t(slices);
   t.pool_bytes = t.paths_in_flight * PoolSlice<T>::bytes_per_path;
   t.table_bytes = table ? table->rows.size() * sizeof(float) : 0;
+  t.isa = k ? k->isa : Isa::Scalar;
   return t;
 }
 
 }  // namespace
 
 // The entry point of this translation unit's instantiations (strategies.h).
+// The batched path step where it applies (job.isa a vector ISA, float, diffuse-only, a
+// small enough scene); packets as wide as its lanes.
 template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight) {
-  return wavefront<T, Kinds>(job, paths_in_flight);
+  std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene, job.isa);
+  const BatchKernels* k = table ? batch_kernels(job.isa) : nullptr;
+  if (k && k->lanes == 16) return wavefront<T, Kinds, 16>(job, paths_in_flight, k, std::move(table));
+  return wavefront<T, Kinds, 8>(job, paths_in_flight, k, std::move(table));
 }
 
 template TraceTotals render_wavefront_for<float, PB_CPU_KINDS>(const TraceJob&, uint64_t);

@@ -1,6 +1,8 @@
 #pragma once
-// What the wavefront's batched shading (shade_x8.h) reads and writes, compiled for the
-// build's baseline instruction set (shade_x8.h itself is AVX2 code).
+// What the batched shading (shade_x8.h) reads and writes, and the table of its entry
+// points per instruction set (BatchKernels), compiled for the build's baseline
+// instruction set (shade_x8.h itself is AVX2 or AVX-512 code, in shade_avx2.cpp and
+// shade_avx512.cpp).
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -8,19 +10,23 @@
 #include <vector>
 
 #include "pathbench/common/path.h"
+#include "pathbench/common/settings.h"
 
 namespace pb::cpu {
 
-constexpr int kShadeLanes = 8;
+// The widest batch: AVX-512's 16 float lanes (AVX2: 8). Arrays are sized for it; a
+// kernel reads its own width of them.
+constexpr int kMaxShadeLanes = 16;
 
-// One batch: eight paths that hit a triangle, and what shading them asks for next.
-struct Shade8 {
-  PathState<float>* st[kShadeLanes];
-  ShadowQuery<float>* shadow[kShadeLanes];
-  uint32_t prim[kShadeLanes];  // hit triangle of each lane
-  int lanes;                   // lanes in use; the rest repeat lane 0 and write nothing
-  bool wants_shadow[kShadeLanes];
-  bool cont[kShadeLanes];      // PathEvent::Continue
+// One batch: up to a kernel's width of paths that hit a triangle, and what shading them
+// asks for next.
+struct ShadeBatch {
+  PathState<float>* st[kMaxShadeLanes];
+  ShadowQuery<float>* shadow[kMaxShadeLanes];
+  uint32_t prim[kMaxShadeLanes];  // hit triangle of each lane
+  int lanes;                      // lanes in use; the rest repeat lane 0 and write nothing
+  bool wants_shadow[kMaxShadeLanes];
+  bool cont[kMaxShadeLanes];      // PathEvent::Continue
 };
 
 // Per triangle, everything shading reads of it, as three rows of eight floats so eight
@@ -59,11 +65,38 @@ struct ShadeTable {
   const float* row(uint32_t triangle) const { return &rows[size_t(triangle) * kRowFloats]; }
 };
 
-// The batched shading runs for diffuse-only float renders on AVX2 CPUs, in scenes small
-// enough for its table: then this returns the table, otherwise null.
-template <class T, uint32_t Kinds> std::unique_ptr<ShadeTable> batched_shading_table(const SceneView& s) {
+// The batched path step of one instruction set, `lanes` paths at a time (shade_x8.h;
+// pointers: the functions are compiled for that instruction set in their own
+// translation units). Arrays passed in hold `lanes` entries; idle lanes repeat lane 0.
+struct BatchKernels {
+  Isa isa;
+  int lanes;
+  // path_begin for `lanes` paths (the first `used` of them are stored).
+  void (*begin_paths)(const SceneView&, const PathConfig&, const uint32_t* pixel, const uint32_t* sample,
+                      PathState<float>* const* st, int used);
+  // Whether an emitter may lie along each path's ray (false only where the scalar
+  // path_final_query would find none).
+  void (*final_vertex_candidates)(const SceneView&, PathState<float>* const* st, bool* candidate);
+  // surface_hit + path_hit for the batch's lanes (diffuse-only, float).
+  void (*shade_diffuse)(const SceneView&, const PathConfig&, const ShadeTable&, ShadeBatch&);
+  // The rays (first six floats) of `lanes` records into an Embree packet's org/dir arrays.
+  void (*rays_to_packet)(const void* const* rows, float* const* org_dir);
+  // sincos_turns<float> (sampling.h) of `lanes` turn fractions (for the tests).
+  void (*sincos_turns)(const float* u, float* s, float* c);
+};
+const BatchKernels& avx2_kernels();    // shade_avx2.cpp
+const BatchKernels& avx512_kernels();  // shade_avx512.cpp
+
+// The kernels for a resolved ISA (cpu/isa.h), or null for Isa::Scalar.
+inline const BatchKernels* batch_kernels(Isa isa) {
+  return isa == Isa::Avx512 ? &avx512_kernels() : isa == Isa::Avx2 ? &avx2_kernels() : nullptr;
+}
+
+// The batched shading runs for diffuse-only float renders with a vector ISA, in scenes
+// small enough for its table: then this returns the table, otherwise null.
+template <class T, uint32_t Kinds> std::unique_ptr<ShadeTable> batched_shading_table(const SceneView& s, Isa isa) {
   if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly)
-    if (__builtin_cpu_supports("avx2") && ShadeTable::fits(s)) return std::make_unique<ShadeTable>(s);
+    if (batch_kernels(isa) && ShadeTable::fits(s)) return std::make_unique<ShadeTable>(s);
   return nullptr;
 }
 

@@ -1,4 +1,4 @@
-// The CPU wavefront's shading of eight paths at once: surface_hit + path_hit (path.h)
+// The CPU's shading of kLanes paths at once (8 with AVX2, 16 with AVX-512): surface_hit + path_hit (path.h)
 // for diffuse-only scenes in float, the case the paper's benchmark runs. Per lane it is
 // path_hit's arithmetic in path_hit's order (simd8.h's operations are the lane-wise
 // twins of the scalar ones), so each path gets bit for bit what the scalar path step
@@ -7,11 +7,13 @@
 // emitter choice, the random numbers, sin/cos -- runs per lane with the scalar code of
 // the path step itself.
 //
-// Included in a namespace named by PB_SIMD_NS under `#pragma GCC target("avx2")`
-// (shade_x8_avx2.h): eight lanes are one AVX register. (Compiled for the SSE2
+// Included once per instruction set, in a namespace named by PB_SIMD_NS with
+// PB_SIMD_LANES lanes, under the matching `#pragma GCC target`, each in a translation
+// unit of its own (shade_avx2.cpp, shade_avx512.cpp; g++ 12 fails on two copies in one):
+// the lanes are one AVX or AVX-512 register. The strategies reach them through
+// BatchKernels (batch_kernels.h), picked at run time by --isa. (Compiled for the SSE2
 // baseline, every vector operation is two SSE ones, the lane shuffles are scalar code,
-// and the batch costs more than the scalar path step; g++ 12 also fails on an SSE2 and
-// an AVX2 copy in one translation unit.)
+// and the batch costs more than the scalar path step.)
 #include <cmath>
 #include <cstdint>
 
@@ -23,43 +25,43 @@
 namespace pb::cpu::PB_SIMD_NS {
 
 // path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), *shadow[i], wants_shadow[i])
-// for every lane i; `table` is built from `s`.
-[[gnu::noinline, gnu::flatten]] inline void shade_diffuse_x8(const SceneView& s, const PathConfig& c, const ShadeTable& table, Shade8& b) {
+// for every lane i < kLanes; `table` is built from `s`.
+[[gnu::flatten]] inline void shade_diffuse(const SceneView& s, const PathConfig& c, const ShadeTable& table, ShadeBatch& b) {
   constexpr int N = kLanes;
   const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
   // The paths' states, one lane each (PathState<float> is two 8-float rows).
-  static_assert(sizeof(PathState<float>) == 2 * sizeof(F8), "PathState<float>: 16 floats, as the rows below");
+  static_assert(sizeof(PathState<float>) == 16 * sizeof(float), "PathState<float>: 16 floats, as the rows below");
   const void* rows[N];
   for (int i = 0; i < N; ++i) rows[i] = b.st[i];
-  F8 ra[N], rb[N];
+  FV ra[N], rb[N];
   load_rows(rows, 0, ra);
   load_rows(rows, 8, rb);
   const V3 o{ra[0], ra[1], ra[2]}, d{ra[3], ra[4], ra[5]};
   const V3 beta{ra[6], ra[7], rb[0]};
   V3 L{rb[1], rb[2], rb[3]};
-  const F8 bsdf_pdf = rb[4];
-  const I8 pixel = bits(rb[5]), sample = bits(rb[6]), depth = bits(rb[7]);
-  const I8 vertex = depth + 1;
-  const I8 mis_e = c.sampling == Sampling::Nee ? (depth > 0) : I8{};
+  const FV bsdf_pdf = rb[4];
+  const IV pixel = bits(rb[5]), sample = bits(rb[6]), depth = bits(rb[7]);
+  const IV vertex = depth + 1;
+  const IV mis_e = c.sampling == Sampling::Nee ? (depth > 0) : IV{};
   // The vertex's four uniforms, drawn for every lane (used only where the lane scatters).
-  F8 ub[4];
-  rng_draw(U8(pixel), c.seed, U8(sample), U8(vertex), kRngVertex, ub);
-  const F8 u0 = ub[0], u1 = ub[1], u3 = ub[3];
-  F8 u_pick = ub[2];
+  FV ub[4];
+  rng_draw(UV(pixel), c.seed, UV(sample), UV(vertex), kRngVertex, ub);
+  const FV u0 = ub[0], u1 = ub[1], u3 = ub[3];
+  FV u_pick = ub[2];
 
   // The hit triangles: geometry and material (ShadeTable rows).
   const void* tri_rows[N];
   for (int i = 0; i < N; ++i) tri_rows[i] = table.row(b.prim[i]);
-  F8 ta[N], tb[N], tc[N];
+  FV ta[N], tb[N], tc[N];
   load_rows(tri_rows, 0, ta);
   load_rows(tri_rows, 8, tb);
   load_rows(tri_rows, 16, tc);
   const V3 v0{ta[0], ta[1], ta[2]}, e1{ta[3], ta[4], ta[5]}, e2{ta[6], ta[7], tb[0]};
   const V3 ng{tb[1], tb[2], tb[3]}, albedo{tb[4], tb[5], tb[6]};
-  const I8 emits = bits(tb[7]);
+  const IV emits = bits(tb[7]);
   const V3 Le{tc[0], tc[1], tc[2]};
-  const I8 at_budget = c.max_bounces >= 0 ? (depth >= c.max_bounces) : I8{};  // depth is small: signed compare is exact
-  const I8 scatters = bits(tc[3]) & ~at_budget;
+  const IV at_budget = c.max_bounces >= 0 ? (depth >= c.max_bounces) : IV{};  // depth is small: signed compare is exact
+  const IV scatters = bits(tc[3]) & ~at_budget;
 
   // Per lane: the emitter light sampling picks (scalar pick_emitter), then its rows.
   uint32_t light[N];
@@ -72,7 +74,7 @@ namespace pb::cpu::PB_SIMD_NS {
     }
     tri_rows[i] = table.row(light[i]);
   }
-  F8 la[N], lb[N], lc[N];
+  FV la[N], lb[N], lc[N];
   load_rows(tri_rows, 0, la);
   load_rows(tri_rows, 8, lb);
   load_rows(tri_rows, 16, lc);
@@ -82,70 +84,70 @@ namespace pb::cpu::PB_SIMD_NS {
 
   // surface_hit (surface_hit.h).
   const V3 pv = cross(d, e2);
-  const F8 inv_det = 1.0f / dot(e1, pv);
+  const FV inv_det = 1.0f / dot(e1, pv);
   const V3 tv = o - v0;
-  F8 b1 = dot(tv, pv) * inv_det;
+  FV b1 = dot(tv, pv) * inv_det;
   const V3 qv = cross(tv, e1);
-  F8 b2 = dot(d, qv) * inv_det;
-  const F8 t = dot(e2, qv) * inv_det;
-  b1 = vmin(vmax(b1, F8{}), splat(1.0f));
-  b2 = vmin(vmax(b2, F8{}), 1.0f - b1);
+  FV b2 = dot(d, qv) * inv_det;
+  const FV t = dot(e2, qv) * inv_det;
+  b1 = vmin(vmax(b1, FV{}), splat(1.0f));
+  b2 = vmin(vmax(b2, FV{}), 1.0f - b1);
   const V3 p = v0 + e1 * b1 + e2 * b2;
 
   // 1. Emission, MIS-weighted after the first vertex (emitted_radiance).
-  const F8 cos_o = -dot(ng, d);
-  const F8 pdf_e = mean3(Le) / s.emitter_power_total * t * t / cos_o;
-  const F8 w_e = select(mis_e, power_heuristic(bsdf_pdf, pdf_e), splat(1.0f));
+  const FV cos_o = -dot(ng, d);
+  const FV pdf_e = mean3(Le) / s.emitter_power_total * t * t / cos_o;
+  const FV w_e = select(mis_e, power_heuristic(bsdf_pdf, pdf_e), splat(1.0f));
   L = select((cos_o > 0.0f) & emits, L + beta * Le * w_e, L);
 
   // 2.-5. For the lanes that scatter.
   const V3 n = select(cos_o >= 0.0f, ng, -ng);
-  const Frame8 frame = Frame8::from_normal(n);
+  const FrameV frame = FrameV::from_normal(n);
   const V3 origin = offset_ray_origin(p, n, s.offset);
 
   // 3. Light sampling.
-  I8 shadow = I8{};
+  IV shadow = IV{};
   V3 contribution, shadow_d;
   if (nee) {
-    const F8 su = sqrt(u_pick);
-    const F8 tb1 = 1.0f - su, tb2 = u3 * su;
+    const FV su = sqrt(u_pick);
+    const FV tb1 = 1.0f - su, tb2 = u3 * su;
     const V3 y = l0 + le1 * tb1 + le2 * tb2;
     V3 wi = y - p;
-    const F8 dist2 = dot(wi, wi);
+    const FV dist2 = dot(wi, wi);
     wi = wi / sqrt(dist2);
-    const F8 cos_s = dot(n, wi);
-    const F8 cos_l = -dot(nl, wi);
+    const FV cos_s = dot(n, wi);
+    const FV cos_l = -dot(nl, wi);
     shadow = scatters & (cos_s > 0.0f) & (cos_l > 0.0f) & (dist2 > 0.0f);
-    const F8 pdf_light = mean3(le_light) / s.emitter_power_total * dist2 / cos_l;
+    const FV pdf_light = mean3(le_light) / s.emitter_power_total * dist2 / cos_l;
     const V3 f = albedo * splat(kInvPi<float>);
-    const F8 f_pdf = vmax(cos_s, F8{}) * kInvPi<float>;
-    const F8 w = power_heuristic(pdf_light, f_pdf);
+    const FV f_pdf = vmax(cos_s, FV{}) * kInvPi<float>;
+    const FV w = power_heuristic(pdf_light, f_pdf);
     contribution = beta * f * le_light * (cos_s * w / pdf_light);
     shadow_d = offset_ray_origin(y, nl, s.offset) - origin;
   }
 
   // 4. Next direction: lambert_sample (bsdf/lambert.h).
-  F8 r, z, pdf;
+  FV r, z, pdf;
   if (c.sampling == Sampling::Uniform) {
     z = u0;
-    r = sqrt(vmax(F8{}, 1.0f - z * z));
+    r = sqrt(vmax(FV{}, 1.0f - z * z));
     pdf = splat(uniform_hemisphere_pdf<float>());
   } else {
     r = sqrt(u0);
-    z = sqrt(vmax(F8{}, 1.0f - u0));
-    pdf = vmax(z, F8{}) * kInvPi<float>;
+    z = sqrt(vmax(FV{}, 1.0f - u0));
+    pdf = vmax(z, FV{}) * kInvPi<float>;
   }
-  F8 sin_phi, cos_phi;
+  FV sin_phi, cos_phi;
   sincos_turns(u1, sin_phi, cos_phi);
   const V3 local{r * cos_phi, r * sin_phi, z};
-  I8 cont = scatters & (pdf > 0.0f) & (z > 0.0f);
+  IV cont = scatters & (pdf > 0.0f) & (z > 0.0f);
   V3 beta_next = beta * (albedo * splat(kInvPi<float>) * (z / pdf));
   const V3 wi_next = frame.to_world(local);
 
   // 5. Russian roulette.
   if (c.russian_roulette) {
-    const F8 q = vmin(vmax(beta_next.x, vmax(beta_next.y, beta_next.z)), splat(0.95f));
-    I8 rr = I8{};
+    const FV q = vmin(vmax(beta_next.x, vmax(beta_next.y, beta_next.z)), splat(0.95f));
+    IV rr = IV{};
     for (int i = 0; i < N; ++i) {
       if (!cont[i] || uint32_t(vertex[i]) < c.rr_start_depth) continue;
       rr[i] = -1;
@@ -163,7 +165,8 @@ namespace pb::cpu::PB_SIMD_NS {
   rb[1] = L.x; rb[2] = L.y; rb[3] = L.z;
   rb[4] = select(cont, pdf, rb[4]);
   rb[7] = from_bits(cont ? vertex : depth);
-  void* const out_rows[N] = {b.st[0], b.st[1], b.st[2], b.st[3], b.st[4], b.st[5], b.st[6], b.st[7]};
+  void* out_rows[N];
+  for (int i = 0; i < N; ++i) out_rows[i] = b.st[i];
   store_rows(ra, out_rows, 0, b.lanes);
   store_rows(rb, out_rows, 8, b.lanes);
   for (int i = 0; i < b.lanes; ++i) {
@@ -181,7 +184,7 @@ namespace pb::cpu::PB_SIMD_NS {
 
 namespace pb::cpu::PB_SIMD_NS {
 
-// The last vertex of a bounded path (path_final_query, path.h), eight paths at once:
+// The last vertex of a bounded path (path_final_query, path.h), kLanes paths at once:
 // whether any emitter lies along each lane's ray. The scalar query then runs only for
 // the lanes marked here (false for most rays: the emitters are small), so this need
 // only never say "no" where the scalar test would find a hit. It computes
@@ -189,47 +192,46 @@ namespace pb::cpu::PB_SIMD_NS {
 // emitter (the scalar loop's bound until its first hit), and marks any lane whose edge
 // functions come out exactly 0 (where watertight.h falls back to double).
 // Keep in step with common/include/pathbench/common/watertight.h.
-[[gnu::noinline]] inline void final_vertex_candidates_x8(const SceneView& s, PathState<float>* const st[kShadeLanes],
-                                                        bool candidate[kShadeLanes]) {
+inline void final_vertex_candidates(const SceneView& s, PathState<float>* const* st, bool* candidate) {
   constexpr int N = kLanes;
   const void* rows[N];
   for (int i = 0; i < N; ++i) rows[i] = st[i];
-  F8 ra[N];
+  FV ra[N];
   load_rows(rows, 0, ra);
   const V3 o{ra[0], ra[1], ra[2]}, d{ra[3], ra[4], ra[5]};
   // make_watertight_ray: the dominant axis kz, then kx, ky (swapped where d[kz] < 0).
-  const F8 ax = abs(d.x), ay = abs(d.y), az = abs(d.z);
-  const I8 z_is_x = (ax > ay) & (ax > az), z_is_y = ~z_is_x & (ay > az), z_is_z = ~z_is_x & ~z_is_y;
-  const F8 dz = select(z_is_x, d.x, select(z_is_y, d.y, d.z));
+  const FV ax = abs(d.x), ay = abs(d.y), az = abs(d.z);
+  const IV z_is_x = (ax > ay) & (ax > az), z_is_y = ~z_is_x & (ay > az), z_is_z = ~z_is_x & ~z_is_y;
+  const FV dz = select(z_is_x, d.x, select(z_is_y, d.y, d.z));
   // kx = kz + 1, ky = kz + 2 (mod 3); a negative dz swaps them.
   auto axis_after = [&](const V3& v, int step) {  // v[(kz + step) % 3]
-    const F8 next_of_x = step == 1 ? v.y : v.z, next_of_y = step == 1 ? v.z : v.x, next_of_z = step == 1 ? v.x : v.y;
+    const FV next_of_x = step == 1 ? v.y : v.z, next_of_y = step == 1 ? v.z : v.x, next_of_z = step == 1 ? v.x : v.y;
     return select(z_is_x, next_of_x, select(z_is_y, next_of_y, next_of_z));
   };
-  const I8 swap = dz < 0.0f;
+  const IV swap = dz < 0.0f;
   auto axis_x = [&](const V3& v) { return select(swap, axis_after(v, 2), axis_after(v, 1)); };
   auto axis_y = [&](const V3& v) { return select(swap, axis_after(v, 1), axis_after(v, 2)); };
   auto axis_z = [&](const V3& v) { return select(z_is_x, v.x, select(z_is_y, v.y, v.z)); };
   (void)z_is_z;
-  const F8 sx = axis_x(d) / dz, sy = axis_y(d) / dz, sz = 1.0f / dz;
-  const F8 t_max = splat(3.402823466e38f);
-  I8 maybe = I8{};
+  const FV sx = axis_x(d) / dz, sy = axis_y(d) / dz, sz = 1.0f / dz;
+  const FV t_max = splat(3.402823466e38f);
+  IV maybe = IV{};
   for (uint32_t k = 0; k < s.num_emitters; ++k) {
     const Triangle tri = s.triangles[s.emitters[k]];
     auto rel = [&](const Vec3f& p) { return V3{p.x - o.x, p.y - o.y, p.z - o.z}; };
     const V3 A = rel(s.positions[tri.v[0]]), B = rel(s.positions[tri.v[1]]), C = rel(s.positions[tri.v[2]]);
-    const F8 Az = axis_z(A), Bz = axis_z(B), Cz = axis_z(C);
-    const F8 Ax = axis_x(A) - sx * Az, Ay = axis_y(A) - sy * Az;
-    const F8 Bx = axis_x(B) - sx * Bz, By = axis_y(B) - sy * Bz;
-    const F8 Cx = axis_x(C) - sx * Cz, Cy = axis_y(C) - sy * Cz;
-    const F8 U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
-    const I8 on_edge = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
-    const I8 outside = ((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f));
-    const F8 det = U + V + W;
-    const F8 T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
-    const I8 in_range = (det > 0.0f) ? ((T > 0.0f) & (T < t_max * det)) : ((T < 0.0f) & (T > t_max * det));
-    const F8 t = T / det;
-    const I8 hit = ~outside & (det != 0.0f) & in_range & (t > 0.0f) & (t < t_max);
+    const FV Az = axis_z(A), Bz = axis_z(B), Cz = axis_z(C);
+    const FV Ax = axis_x(A) - sx * Az, Ay = axis_y(A) - sy * Az;
+    const FV Bx = axis_x(B) - sx * Bz, By = axis_y(B) - sy * Bz;
+    const FV Cx = axis_x(C) - sx * Cz, Cy = axis_y(C) - sy * Cz;
+    const FV U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
+    const IV on_edge = (U == 0.0f) | (V == 0.0f) | (W == 0.0f);
+    const IV outside = ((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f));
+    const FV det = U + V + W;
+    const FV T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
+    const IV in_range = (det > 0.0f) ? ((T > 0.0f) & (T < t_max * det)) : ((T < 0.0f) & (T > t_max * det));
+    const FV t = T / det;
+    const IV hit = ~outside & (det != 0.0f) & in_range & (t > 0.0f) & (t < t_max);
     maybe |= on_edge | hit;
   }
   for (int i = 0; i < N; ++i) candidate[i] = maybe[i] != 0;
@@ -239,37 +241,37 @@ namespace pb::cpu::PB_SIMD_NS {
 
 namespace pb::cpu::PB_SIMD_NS {
 
-// path_begin (path.h) for eight new paths: camera_ray (camera.h) lane-wise in its order
+// path_begin (path.h) for kLanes new paths: camera_ray (camera.h) lane-wise in its order
 // of operations, the camera's random numbers from rng_draw.
-[[gnu::noinline]] inline void begin_paths_x8(const SceneView& s, const PathConfig& c, const uint32_t pixel[kShadeLanes],
-                                            const uint32_t sample[kShadeLanes], PathState<float>* const st[kShadeLanes],
-                                            int lanes) {
+inline void begin_paths(const SceneView& s, const PathConfig& c, const uint32_t* pixel, const uint32_t* sample,
+                        PathState<float>* const* st, int lanes) {
   constexpr int N = kLanes;
-  U8 pix, smp;
-  I8 px, py;
+  UV pix, smp;
+  IV px, py;
   for (int i = 0; i < N; ++i) {
     pix[i] = pixel[i];
     smp[i] = sample[i];
     px[i] = int32_t(pixel[i] % c.width);
     py[i] = int32_t(pixel[i] / c.width);
   }
-  F8 u[4];
-  rng_draw(pix, c.seed, smp, U8{}, kRngCamera, u);
+  FV u[4];
+  rng_draw(pix, c.seed, smp, UV{}, kRngCamera, u);
   const Camera& cam = s.camera;
   const float w = float(c.width), h = float(c.height);
-  const F8 sx = (__builtin_convertvector(px, F8) + u[0]) / w * 2.0f - 1.0f;
-  const F8 sy = 1.0f - (__builtin_convertvector(py, F8) + u[1]) / h * 2.0f;
+  const FV sx = (__builtin_convertvector(px, FV) + u[0]) / w * 2.0f - 1.0f;
+  const FV sy = 1.0f - (__builtin_convertvector(py, FV) + u[1]) / h * 2.0f;
   const float tan_y = cam.tan_half_fov_y;
   const float tan_x = tan_y * w / h;
   auto bc = [](const Vec3f& v) { return V3{splat(v.x), splat(v.y), splat(v.z)}; };
   const V3 d = normalize(bc(cam.forward) + bc(cam.right) * (sx * tan_x) + bc(cam.up) * (sy * tan_y));
-  F8 ra[N], rb[N];
+  FV ra[N], rb[N];
   ra[0] = splat(cam.position.x); ra[1] = splat(cam.position.y); ra[2] = splat(cam.position.z);
   ra[3] = d.x; ra[4] = d.y; ra[5] = d.z;
   ra[6] = ra[7] = rb[0] = splat(1.0f);             // beta
-  rb[1] = rb[2] = rb[3] = rb[4] = F8{};            // L, bsdf_pdf
-  rb[5] = from_bits(I8(pix)); rb[6] = from_bits(I8(smp)); rb[7] = F8{};  // pixel, sample, depth 0
-  void* const out_rows[N] = {st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]};
+  rb[1] = rb[2] = rb[3] = rb[4] = FV{};            // L, bsdf_pdf
+  rb[5] = from_bits(IV(pix)); rb[6] = from_bits(IV(smp)); rb[7] = FV{};  // pixel, sample, depth 0
+  void* out_rows[N];
+  for (int i = 0; i < N; ++i) out_rows[i] = st[i];
   store_rows(ra, out_rows, 0, lanes);
   store_rows(rb, out_rows, 8, lanes);
 }
@@ -278,14 +280,13 @@ namespace pb::cpu::PB_SIMD_NS {
 
 namespace pb::cpu::PB_SIMD_NS {
 
-// A ray (the first six floats of each of eight records: PathState::ray, ShadowQuery::ray)
-// into the arrays of an Embree packet: what set_lane (embree_rays.h) does for floats.
-[[gnu::noinline]] inline void rays_to_packet_x8(const void* const rows[kShadeLanes], float* org_x, float* org_y,
-                                               float* org_z, float* dir_x, float* dir_y, float* dir_z) {
-  F8 r[kLanes];
+// A ray (the first six floats of each of kLanes records: PathState::ray, ShadowQuery::ray)
+// into the arrays of an Embree packet of kLanes rays (out: org_x, org_y, org_z, dir_x,
+// dir_y, dir_z): what set_lane (embree_rays.h) does for floats.
+inline void rays_to_packet(const void* const* rows, float* const* out) {
+  FV r[8];
   load_rows(rows, 0, r);
-  float* const out[6] = {org_x, org_y, org_z, dir_x, dir_y, dir_z};
-  for (int j = 0; j < 6; ++j) _mm256_storeu_ps(out[j], __m256(r[j]));
+  for (int j = 0; j < 6; ++j) std::memcpy(out[j], &r[j], sizeof r[j]);
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS

@@ -25,6 +25,7 @@ struct TraceJob {
   uint32_t spp;
   Film& film;
   Progress& progress;
+  Isa isa;  // resolved (cpu/isa.h): the batched path step's instruction set, or Scalar
 };
 
 struct TraceTotals {
@@ -35,6 +36,7 @@ struct TraceTotals {
   uint64_t paths_in_flight = 0;
   uint64_t pool_bytes = 0;
   uint64_t table_bytes = 0;  // wavefront: the batched shading's per-triangle table (shade_batch.h)
+  Isa isa = Isa::Scalar;     // the path step's ISA: a vector one where the batched step ran
 };
 
 // Rays are counted where they are traced. A path's first ray is its camera ray whatever
@@ -51,15 +53,15 @@ inline void count_ray(RayCounts& rays, uint32_t depth, uint64_t RayCounts::*othe
 // render_*_all_kinds.cpp), and the entry points pick one per render from the scene's
 // features (features.h).
 // One thread per image tile; each pixel sample traced as its own path with single rays
-// (rtcIntersect1/rtcOccluded1), the path steps of up to eight samples of a pixel run
-// side by side where the batched shading applies (render_pixel.cpp).
+// (rtcIntersect1/rtcOccluded1), the path steps of up to 16 (AVX-512) or 8 (AVX2) samples
+// of a pixel run side by side where the batched shading applies (render_pixel.cpp).
 template <class T, uint32_t Kinds> TraceTotals render_pixel_parallel_for(const TraceJob& job);
 template <class T> TraceTotals render_pixel_parallel(const TraceJob& job) {
   return with_features(job.scene.material_kinds,
                        [&](auto kinds) { return render_pixel_parallel_for<T, decltype(kinds)::value>(job); });
 }
 // Bounded pool of paths per thread; each stage runs over the whole pool, rays go to
-// Embree in 8-wide packets; finished paths are replaced by new samples.
+// Embree in packets of 16 (AVX-512) or 8; finished paths are replaced by new samples.
 template <class T, uint32_t Kinds> TraceTotals render_wavefront_for(const TraceJob& job, uint64_t paths_in_flight);
 template <class T> TraceTotals render_wavefront(const TraceJob& job, uint64_t paths_in_flight) {
   return with_features(job.scene.material_kinds,

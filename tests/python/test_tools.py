@@ -98,3 +98,35 @@ def test_speed_markdown_with_raw_embree():
     md = mitsuba_speed.markdown(res)
     assert "| pixel | 52.0 M / 50.0 M / 85.0 M | rtcIntersect1 / rtcOccluded1 | 16.0 M | 12.0 M | 75% |" in md
     assert "intersect1/coherent 20.0" in md
+
+
+def test_speed_runner_passes_options_with_values(tmp_path):
+    r = mitsuba_speed.PathbenchRunner("pathbench", "wavefront/isa=avx2/no-watertight", 8, 16, tmp_path)
+    assert r.strategy == "wavefront"
+    assert r.flags == ["--isa", "avx2", "--no-watertight"]
+    assert not r.watertight
+
+
+def test_speed_markdown_names_cpu_flags_and_isa():
+    res = _speed_result()
+    res["machine"]["cpu_flags"] = ["avx2", "avx512f"]
+    res["pathbench"]["pixel"]["isa"] = "avx512"
+    md = mitsuba_speed.markdown(res)
+    assert "CPU vector flags: avx2 avx512f; pathbench's path step ran pixel: avx512." in md
+
+
+def test_cpu_vector_flags_reads_cpuinfo(tmp_path):
+    from machine import cpu_vector_flags
+    f = tmp_path / "cpuinfo"
+    f.write_text("model name\t: X\nflags\t\t: fpu sse4_2 avx2 avx512vl avx512f\n")
+    assert cpu_vector_flags(str(f)) == ["sse4_2", "avx2", "avx512f", "avx512vl"]
+
+
+def test_raw_shares_per_isa():
+    rates = _rates(10.0, 5.0, 25.0, "1") | _rates(20.0, 10.0, 50.0, "16")
+    rays = {"camera": 100, "bounce": 50, "shadow": 250, "total": 400}
+    reports = [{"strategy": "wavefront", "isa": i, "rays": rays, "rays_per_second": v} for i, v in
+               (("avx512", 20.0), ("avx2", 10.0))]
+    out = raw_embree_mix.shares(reports, rates)
+    assert [(s["isa"], s["share"]) for s in out] == [("avx512", round(20.0 / (400 / 15), 4)),
+                                                      ("avx2", round(10.0 / (400 / 15), 4))]

@@ -1,8 +1,9 @@
-// The CPU wavefront's batched (AVX2) shading and final-vertex screen, cpu/src/shade_x8.h,
-// against the scalar path step they stand in for: the same image bit for bit on scenes
-// beyond the paper's box (many triangles, several emitters, an icosphere), and a screen
-// that never drops a ray the scalar watertight test says hits an emitter, including rays
-// aimed exactly at the emitters' vertices and edges.
+// The CPU's batched shading and final-vertex screen (cpu/src/shade_x8.h, for AVX2 and
+// AVX-512 through BatchKernels) against the scalar path step they stand in for: the same
+// image bit for bit on scenes beyond the paper's box (many triangles, several emitters,
+// an icosphere) with every ISA (--isa) and strategy, and a screen that never drops a ray
+// the scalar watertight test says hits an emitter, including rays aimed exactly at the
+// emitters' vertices and edges. ISAs this CPU lacks are skipped, saying so.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,33 +11,19 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <vector>
 
+#include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/cpu/isa.h"
 #include "pathbench/cpu/render.h"
-
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#define PB_SIMD_NS avx2
-#include "../../cpu/src/shade_x8.h"
-#undef PB_SIMD_NS
-namespace {
-// Eight lanes of sincos_turns; vectors stay inside AVX2 code (passing them by value
-// between AVX2 and baseline functions would not agree on the calling convention).
-void sincos_turns_x8(const float* u, float* s, float* c) {
-  pb::cpu::avx2::F8 u8, s8, c8;
-  std::memcpy(&u8, u, sizeof u8);
-  pb::cpu::avx2::sincos_turns(u8, s8, c8);
-  std::memcpy(s, &s8, sizeof s8);
-  std::memcpy(c, &c8, sizeof c8);
-}
-}  // namespace
-#pragma GCC pop_options
+#include "shade_batch.h"
 
 namespace pb {
 namespace {
 
-Film render(const Scene& scene, Strategy strategy, int threads, Sampling sampling, int bounces) {
+Film render(const Scene& scene, Strategy strategy, int threads, Sampling sampling, int bounces, Isa isa = Isa::Auto) {
   RenderSettings s;
   s.width = s.height = 32;
   s.spp = 8;
@@ -46,11 +33,66 @@ Film render(const Scene& scene, Strategy strategy, int threads, Sampling samplin
   s.strategy = strategy;
   s.threads = threads;
   s.seed = 7;
+  s.isa = isa;
   s.progress = false;
   Film film(s.width, s.height, false);
   RunReport report;
   cpu::render(scene, s, film, report);
+  EXPECT_EQ(report.extra["isa"], isa == Isa::Auto ? to_string(cpu::resolve_isa(isa)) : to_string(isa));
   return film;
+}
+
+// The vector ISAs, each with its kernels (tests skip where this CPU lacks the ISA).
+class BatchIsa : public ::testing::TestWithParam<Isa> {
+ protected:
+  const cpu::BatchKernels& kernels() const { return *cpu::batch_kernels(GetParam()); }
+};
+std::string cpu_flags_text() {
+  std::string f;
+  for (const std::string& x : cpu::cpu_vector_flags()) f += (f.empty() ? "" : " ") + x;
+  return f;
+}
+#define PB_SKIP_WITHOUT_ISA()                                                                         \
+  if (!cpu::cpu_supports(GetParam()))                                                                \
+  GTEST_SKIP() << "this CPU lacks " << to_string(GetParam()) << " (it has: " << cpu_flags_text() \
+               << "); that batched path step cannot run here"
+
+INSTANTIATE_TEST_SUITE_P(Isas, BatchIsa, ::testing::Values(Isa::Avx2, Isa::Avx512),
+                         [](const auto& info) { return std::string(to_string(info.param)); });
+
+// Every strategy with this ISA against the scalar pixel strategy (the reference path
+// step, one path at a time): same sums and counts, bit for bit.
+TEST_P(BatchIsa, SameImageAsScalar) {
+  PB_SKIP_WITHOUT_ISA();
+  for (const char* name : {"paper-cornell", "cornell-box", "paper-cornell-ico:2", "furnace"}) {
+    const Scene scene = std::string(name) == "furnace" ? make_furnace(0.5f, 1.0f) : load_scene(name);
+    for (auto [sampling, bounces] : {std::pair{Sampling::Nee, 2}, std::pair{Sampling::Uniform, 3},
+                                     std::pair{Sampling::Nee, -1}}) {
+      SCOPED_TRACE(std::string(name) + ", " + to_string(sampling) + ", bounces " + std::to_string(bounces));
+      const Film reference = render(scene, Strategy::Pixel, 1, sampling, bounces, Isa::Scalar);
+      for (Strategy strategy : {Strategy::Pixel, Strategy::Wavefront}) {
+        SCOPED_TRACE(to_string(strategy));
+        const Film f = render(scene, strategy, 2, sampling, bounces, GetParam());
+        EXPECT_TRUE(reference.raw_sums() == f.raw_sums());
+        EXPECT_TRUE(reference.counts() == f.counts());
+      }
+    }
+  }
+}
+
+TEST(Isa, NamesAndRefusals) {
+  for (Isa i : {Isa::Auto, Isa::Avx512, Isa::Avx2, Isa::Scalar}) EXPECT_EQ(parse_isa(to_string(i)), i);
+  EXPECT_THROW(parse_isa("sse2"), InputError);
+  EXPECT_EQ(cpu::resolve_isa(Isa::Scalar), Isa::Scalar);
+  const Isa best = cpu::resolve_isa(Isa::Auto);
+  EXPECT_NE(best, Isa::Auto);
+  EXPECT_TRUE(cpu::cpu_supports(best));
+  for (Isa i : {Isa::Avx512, Isa::Avx2}) {
+    if (cpu::cpu_supports(i)) EXPECT_EQ(cpu::resolve_isa(i), i);
+    else EXPECT_THROW(cpu::resolve_isa(i), InputError);
+  }
+  EXPECT_EQ(cpu::isa_lanes(Isa::Avx512), 16);
+  EXPECT_EQ(cpu::isa_lanes(Isa::Avx2), 8);
 }
 
 TEST(WavefrontBatch, SameImageAsPixelOnOtherScenes) {
@@ -80,8 +122,10 @@ bool scalar_finds_emitter(const SceneView& s, const Ray<float>& ray) {
   return false;
 }
 
-TEST(WavefrontBatch, FinalVertexScreenKeepsEveryHit) {
-  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2: the wavefront shades one path at a time";
+TEST_P(BatchIsa, FinalVertexScreenKeepsEveryHit) {
+  PB_SKIP_WITHOUT_ISA();
+  const cpu::BatchKernels& k = kernels();
+  const int N = k.lanes;
   const Scene scene = make_cornell_box();
   const SceneView s = scene.view();
   ASSERT_GT(s.num_emitters, 0u);
@@ -92,12 +136,13 @@ TEST(WavefrontBatch, FinalVertexScreenKeepsEveryHit) {
     return Vec3f{lo.x + (hi.x - lo.x) * (0.5f + 0.49f * u(rng)), lo.y + (hi.y - lo.y) * (0.5f + 0.49f * u(rng)),
                  lo.z + (hi.z - lo.z) * (0.5f + 0.49f * u(rng))};
   };
-  std::vector<PathState<float>> states(8);
-  PathState<float>* lanes[8];
-  for (int i = 0; i < 8; ++i) lanes[i] = &states[i];
+  std::vector<PathState<float>> states(static_cast<size_t>(N));
+  PathState<float>* lanes[cpu::kMaxShadeLanes];
+  for (int i = 0; i < N; ++i) lanes[i] = &states[size_t(i)];
   size_t hits = 0, screened_out = 0;
-  for (int round = 0; round < 4000; ++round) {
-    for (int i = 0; i < 8; ++i) {
+  const int rounds = 32000 / N;
+  for (int round = 0; round < rounds; ++round) {
+    for (int i = 0; i < N; ++i) {
       const Vec3f o = inside();
       Vec3f d{u(rng), u(rng), u(rng)};
       // Every other ray aims exactly at an emitter vertex or an edge midpoint.
@@ -106,12 +151,12 @@ TEST(WavefrontBatch, FinalVertexScreenKeepsEveryHit) {
         const Vec3f a = s.positions[t.v[rng() % 3]], b = s.positions[t.v[rng() % 3]];
         d = (a + b) * 0.5f - o;
       }
-      states[i].ray = {o, d};
+      states[size_t(i)].ray = {o, d};
     }
-    bool candidate[8];
-    cpu::avx2::final_vertex_candidates_x8(s, lanes, candidate);
-    for (int i = 0; i < 8; ++i) {
-      const bool hit = scalar_finds_emitter(s, states[i].ray);
+    bool candidate[cpu::kMaxShadeLanes];
+    k.final_vertex_candidates(s, lanes, candidate);
+    for (int i = 0; i < N; ++i) {
+      const bool hit = scalar_finds_emitter(s, states[size_t(i)].ray);
       hits += hit;
       screened_out += !candidate[i];
       if (hit) ASSERT_TRUE(candidate[i]) << "round " << round << " lane " << i;
@@ -122,8 +167,7 @@ TEST(WavefrontBatch, FinalVertexScreenKeepsEveryHit) {
 }
 
 // sincos_turns<float> (sampling.h) over every float turn fraction the random stream can
-// give (k / 2^24): within 3e-7 of sin and cos of 2 pi u, and the AVX2 lanes give the
-// same bits as the scalar function.
+// give (k / 2^24): within 3e-7 of sin and cos of 2 pi u.
 TEST(WavefrontBatch, SinCosOfTurns) {
   double worst = 0;
   for (uint32_t k = 0; k < (1u << 24); k += 7) {
@@ -134,16 +178,22 @@ TEST(WavefrontBatch, SinCosOfTurns) {
     worst = std::max({worst, std::fabs(double(s) - std::sin(phi)), std::fabs(double(c) - std::cos(phi))});
   }
   EXPECT_LT(worst, 3e-7);
-  if (!__builtin_cpu_supports("avx2")) return;
-  float u[8], s8[8], c8[8];
-  for (uint32_t k = 0; k < (1u << 24); k += 8 * 11) {
-    for (int i = 0; i < 8; ++i) u[i] = float(k + uint32_t(i)) * (1.0f / 16777216.0f);
-    sincos_turns_x8(u, s8, c8);
-    for (int i = 0; i < 8; ++i) {
+}
+
+// The vector lanes of sincos_turns give the scalar function's bits.
+TEST_P(BatchIsa, SinCosOfTurnsLanes) {
+  PB_SKIP_WITHOUT_ISA();
+  const cpu::BatchKernels& k = kernels();
+  const uint32_t N = uint32_t(k.lanes);
+  float u[cpu::kMaxShadeLanes], sv[cpu::kMaxShadeLanes], cv[cpu::kMaxShadeLanes];
+  for (uint32_t base = 0; base < (1u << 24); base += N * 11) {
+    for (uint32_t i = 0; i < N; ++i) u[i] = float(base + i) * (1.0f / 16777216.0f);
+    k.sincos_turns(u, sv, cv);
+    for (uint32_t i = 0; i < N; ++i) {
       float s, c;
       sincos_turns(u[i], s, c);
-      ASSERT_EQ(s, s8[i]) << u[i];
-      ASSERT_EQ(c, c8[i]) << u[i];
+      ASSERT_EQ(s, sv[i]) << u[i];
+      ASSERT_EQ(c, cv[i]) << u[i];
     }
   }
 }

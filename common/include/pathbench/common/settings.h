@@ -25,6 +25,10 @@ enum class Precision : uint32_t { Float = 0, Double = 1 };
 // the scene; Auto measures both on a short probe and keeps the faster
 // (cpu/embree_layout.h). The GPU ignores it.
 enum class EmbreeLayout : uint32_t { Auto = 0, Triangles = 1, Quads = 2 };
+// Instruction set of the CPU tracer's batched path step (cpu/isa.h): Auto takes the
+// widest the CPU has (AVX-512: 16 lanes, AVX2: 8), Scalar the reference path step one
+// path at a time. Every choice gives the same image bit for bit. The GPU ignores it.
+enum class Isa : uint32_t { Auto = 0, Avx512 = 1, Avx2 = 2, Scalar = 3 };
 
 struct PathConfig {
   int32_t max_bounces;        // diffuse reflections; -1 = unbounded (Russian roulette ends paths)
@@ -51,6 +55,7 @@ struct RenderSettings {
   bool watertight = true;        // watertight ray/triangle test (CPU: Embree's robust mode)
   Precision precision = Precision::Float;  // scalar type of the path step
   EmbreeLayout embree_layout = EmbreeLayout::Auto;  // CPU only
+  Isa isa = Isa::Auto;                               // CPU only
   bool progress = true;
 
   PathConfig path_config() const {
@@ -66,10 +71,12 @@ const char* to_string(Strategy s);
 const char* to_string(Device d);
 const char* to_string(Precision p);
 const char* to_string(EmbreeLayout l);
+const char* to_string(Isa i);
 Sampling parse_sampling(std::string_view s);  // throw InputError on unknown names
 Strategy parse_strategy(std::string_view s);
 Device parse_device(std::string_view s);
 Precision parse_precision(std::string_view s);
 EmbreeLayout parse_embree_layout(std::string_view s);
+Isa parse_isa(std::string_view s);
 
 }  // namespace pb

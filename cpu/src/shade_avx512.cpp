@@ -1,0 +1,9 @@
+// The batched path step for AVX-512: 16 lanes (shade_kernels.inc). The target implies
+// FMA; -ffp-contract=off (top-level CMakeLists.txt) keeps a * b + c two roundings, as in
+// the scalar path step.
+#define PB_SIMD_NS avx512
+#define PB_SIMD_LANES 16
+#define PB_SIMD_TARGET "avx512f,avx512bw,avx512dq,avx512vl"
+#define PB_SIMD_ISA Avx512
+#define PB_SIMD_KERNELS avx512_kernels
+#include "shade_kernels.inc"
