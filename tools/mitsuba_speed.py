@@ -108,11 +108,11 @@ class PathbenchRunner:
     `spec` is a strategy, optionally with flags after '/': "wavefront/no-watertight",
     "pixel/isa=avx2" (an option with its value)."""
 
-    def __init__(self, binary, spec, spp, size, tmp):
+    def __init__(self, binary, spec, spp, size, tmp, label=None):
         self.strategy, *flags = spec.split("/")
         self.flags = [x for f in flags for x in (f"--{f}".split("=", 1))]
         self.watertight = "no-watertight" not in flags
-        self.label = spec
+        self.label = label or spec
         self.binary, self.spp, self.size, self.tmp = binary, spp, size, Path(tmp)
         self.runs = []
 
@@ -254,6 +254,9 @@ def main(argv=None):
                     help="comma list of `pathbench render --isa` values (auto, avx512, avx2, scalar): each strategy "
                          "once per ISA (default: the binary's own choice, auto)")
     ap.add_argument("--no-raw", action="store_true", help="skip the raw Embree ray casts (pathbench-bench)")
+    ap.add_argument("--baseline", help="another pathbench binary (e.g. a build of an older commit): its pixel and "
+                                       "wavefront strategies run in the same interleaved rounds, labelled "
+                                       "'STRATEGY@baseline', so a before/after ratio comes from one run")
     a = ap.parse_args(argv)
     specs = [s for s in a.strategies.split(",")]
     if a.isa:
@@ -276,6 +279,9 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         mitsuba = MitsubaRunner(a.spp, a.variant, a.size)
         ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp) for s in specs}
+        if a.baseline:
+            for s in ("pixel", "wavefront"):
+                ours[f"{s}@baseline"] = PathbenchRunner(a.baseline, s, a.spp, a.size, tmp, label=f"{s}@baseline")
         for _ in range(a.repeats):
             mitsuba.run()
             for r in ours.values():
