@@ -67,12 +67,6 @@ int run_bench(const BenchOptions& o, const std::vector<std::string>& passthrough
     throw InputError(
         fmt::format("--preset: unknown preset '{}' (expected quick, paper, scaling or materials)", o.preset));
   if (o.repetitions < 0) throw InputError("--repetitions: must be >= 0");
-  std::error_code ec;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::filesystem::path bin = (ec ? std::filesystem::path(".") : self.parent_path()) / "pathbench-bench";
-  if (!std::filesystem::exists(bin))
-    throw InputError(fmt::format("{}: not found (build the target pathbench-bench; it needs Google Benchmark)",
-                                 bin.string()));
   // --out goes to a temporary file in the target folder (Google Benchmark writes it
   // unchecked, in place); it is renamed into place only when pathbench-bench
   // succeeded and the file holds complete JSON. So this runs it as a child.
@@ -83,6 +77,12 @@ int run_bench(const BenchOptions& o, const std::vector<std::string>& passthrough
     check_output_path(o.out, "--out");
     out.emplace(o.out);
   }
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::filesystem::path bin = (ec ? std::filesystem::path(".") : self.parent_path()) / "pathbench-bench";
+  if (!std::filesystem::exists(bin))
+    throw InputError(fmt::format("{}: not found (build the target pathbench-bench; it needs Google Benchmark)",
+                                 bin.string()));
   std::vector<std::string> args = {bin.string(), "--preset", o.preset};
   if (out) {
     args.push_back("--benchmark_out=" + out->temp_path());
