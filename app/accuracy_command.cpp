@@ -305,7 +305,7 @@ int run_accuracy(AccuracyOptions& o) {
   std::string command;
   switch (run_report_tool(json_path, command)) {
     case ToolRun::Done: return 0;
-    case ToolRun::Failed: fmt::print(stderr, "accuracy: the report tool failed: {}\n", command); return 1;
+    case ToolRun::Failed: fmt::print(stderr, "accuracy: the report tool failed: {}\n", command); return kExitFailed;
     case ToolRun::Unavailable: break;
   }
   fmt::print(stderr,

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
     return pb::kExitBadInput;
   } catch (const std::exception& e) {
     fmt::print(stderr, "pathbench: failed: {}\n", e.what());
-    return 1;
+    return pb::kExitFailed;
   }
   return 0;
 }
