@@ -13,6 +13,7 @@
 
 #include "accuracy_metrics.h"
 #include "accuracy_reference.h"
+#include "cli_checks.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
@@ -150,17 +151,17 @@ void add_accuracy_options(CLI::App& cmd, AccuracyOptions& o) {
   cmd.add_option("--scene", o.scene, "built-in scene name or a .json / .obj file")->capture_default_str();
   cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
   cmd.add_option("--strategy", o.strategy, "pixel or wavefront (GPU also paper-queue)")->capture_default_str();
-  cmd.add_option("--width", o.width, "image width")->capture_default_str();
-  cmd.add_option("--height", o.height, "image height")->capture_default_str();
-  cmd.add_option("--reference-spp", o.reference_spp, "samples per pixel of the converged reference")->capture_default_str();
+  cmd.add_option("--width", o.width, "image width")->check(non_negative())->capture_default_str();
+  cmd.add_option("--height", o.height, "image height")->check(non_negative())->capture_default_str();
+  cmd.add_option("--reference-spp", o.reference_spp, "samples per pixel of the converged reference")->check(non_negative())->capture_default_str();
   cmd.add_option("--max-spp", o.max_spp, "last rung of each configuration's spp ladder (1, 4, 16, ...) at most")
-      ->capture_default_str();
+      ->check(non_negative())->capture_default_str();
   cmd.add_option("--max-seconds", o.max_seconds,
                  "a configuration's ladder stops before a render expected to take longer than this")
       ->capture_default_str();
   cmd.add_option("--configs", o.configs, "comma-separated configuration names (default: all)");
   cmd.add_option("--out-dir", o.out_dir, "output folder (default results/<machine>/accuracy; the reference is cached there)");
-  cmd.add_option("--seed", o.seed, "random seed of the sweep renders")->capture_default_str();
+  cmd.add_option("--seed", o.seed, "random seed of the sweep renders")->check(non_negative())->capture_default_str();
   cmd.add_option("--threads", o.threads, "CPU threads (0: all)")->capture_default_str();
   cmd.add_flag("--quick", o.quick, "smoke test: 32x32, reference 256 spp, ladder up to 16 spp (unless given)");
   cmd.add_flag("--regenerate-reference", o.regenerate_reference, "render the reference even if it is cached");
@@ -188,6 +189,7 @@ int run_accuracy(AccuracyOptions& o) {
   const std::string dir = o.out_dir.empty() ? "results/" + machine_folder(base.device) + "/accuracy" : o.out_dir;
   const std::string stem = fmt::format("{}-{}x{}-{}", file_slug(scene.name), o.width, o.height, to_string(base.device));
   const std::string image_dir = "images/" + stem;
+  check_output_path((fs::path(dir) / (stem + ".json")).string(), "--out-dir");  // before the sweep
   fs::create_directories(fs::path(dir) / image_dir);
   // Per-render images are for the report tool (FLIP), not for the repository.
   write_text_file((fs::path(dir) / "images" / ".gitignore").string(), "*\n");
@@ -303,7 +305,7 @@ int run_accuracy(AccuracyOptions& o) {
   std::string command;
   switch (run_report_tool(json_path, command)) {
     case ToolRun::Done: return 0;
-    case ToolRun::Failed: fmt::print(stderr, "accuracy: the report tool failed: {}\n", command); return 1;
+    case ToolRun::Failed: fmt::print(stderr, "accuracy: the report tool failed: {}\n", command); return kExitFailed;
     case ToolRun::Unavailable: break;
   }
   fmt::print(stderr,

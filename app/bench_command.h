@@ -15,7 +15,8 @@ struct BenchOptions {
 };
 
 void add_bench_options(CLI::App& cmd, BenchOptions& o);
-// Replaces this process with pathbench-bench; returns only on failure.
+// Replaces this process with pathbench-bench (with --out: runs it as a child and
+// renames the JSON into place only when it is complete); returns its exit status.
 int run_bench(const BenchOptions& o, const std::vector<std::string>& passthrough);
 
 }  // namespace pb::app

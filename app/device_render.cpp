@@ -2,8 +2,6 @@
 
 #include <fmt/core.h>
 
-#include <filesystem>
-#include <fstream>
 #include <stdexcept>
 
 #include "pathbench/common/errors.h"
@@ -45,18 +43,6 @@ std::string machine_folder(Device device) {
 #endif
   (void)device;
   return machine_slug();
-}
-
-void write_text_file(const std::string& path, const std::string& text) {
-  std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error(fmt::format("{}: write failed", path));
-  }
-  std::filesystem::rename(tmp, path);
 }
 
 }  // namespace pb::app

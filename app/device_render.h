@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pathbench/common/film.h"
+#include "pathbench/common/output_file.h"  // write_text_file, for the commands
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
@@ -21,8 +22,5 @@ double render_seconds(const RunReport& r);
 // The results/<machine>/ folder name for runs on `device`: the CPU's slug, or the
 // GPU's (pb::gpu::DeviceInfo::slug) since the GPU sets a GPU run's numbers.
 std::string machine_folder(Device device);
-
-// Writes text to `path` through a temporary file and a rename.
-void write_text_file(const std::string& path, const std::string& text);
 
 }  // namespace pb::app

@@ -2,12 +2,15 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <exception>
+#include <string>
 
 #include "accuracy_command.h"
 #include "bench_command.h"
 #include "compare_command.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/output_file.h"
 #include "render_command.h"
 #include "reproduce_command.h"
 
@@ -36,9 +39,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);  // prints the message
+    // One line with the same prefix as every other user error (CLI11's own print is
+    // two lines without it). Multi-line messages are joined.
+    std::string message = e.what();
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    fmt::print(stderr, "pathbench: error: {}\n", message);
     return pb::kExitBadInput;
   }
+  // From here on output files are being written: a fatal signal removes their
+  // temporary files (exit by the signal, 128 + its number in the shell).
+  pb::install_output_signal_cleanup();
   try {
     if (render_cmd->parsed()) return pb::app::run_render(render);
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
@@ -50,7 +60,7 @@ int main(int argc, char** argv) {
     return pb::kExitBadInput;
   } catch (const std::exception& e) {
     fmt::print(stderr, "pathbench: failed: {}\n", e.what());
-    return 1;
+    return pb::kExitFailed;
   }
   return 0;
 }

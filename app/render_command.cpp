@@ -2,8 +2,13 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <iterator>
+#include <utility>
+#include <vector>
 
+#include "cli_checks.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
@@ -12,9 +17,9 @@ namespace pb::app {
 
 void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--scene", o.scene, "built-in scene name or a .json / .obj file")->capture_default_str();
-  cmd.add_option("--width", o.settings.width, "image width in pixels")->capture_default_str();
-  cmd.add_option("--height", o.settings.height, "image height in pixels")->capture_default_str();
-  cmd.add_option("--spp", o.settings.spp, "samples per pixel")->capture_default_str();
+  cmd.add_option("--width", o.settings.width, "image width in pixels")->check(non_negative())->capture_default_str();
+  cmd.add_option("--height", o.settings.height, "image height in pixels")->check(non_negative())->capture_default_str();
+  cmd.add_option("--spp", o.settings.spp, "samples per pixel")->check(non_negative())->capture_default_str();
   auto* b = cmd.add_option("--bounces", o.settings.max_bounces, "diffuse bounces (the paper: 2)")->capture_default_str();
   cmd.add_flag("--converged", o.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
   cmd.add_flag("--rr,!--no-rr", o.settings.russian_roulette, "Russian roulette (default: only with --converged)");
@@ -33,9 +38,11 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--sampling", o.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
   cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
   cmd.add_option("--strategy", o.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
-  cmd.add_option("--paths-in-flight", o.settings.paths_in_flight, "wavefront pool size (0: device default)");
+  cmd.add_option("--paths-in-flight", o.settings.paths_in_flight,
+                 "wavefront pool size (0: device default; at most the frame's samples)")
+      ->check(non_negative());
   cmd.add_option("--threads", o.settings.threads, "CPU threads (0: all)")->capture_default_str();
-  cmd.add_option("--seed", o.settings.seed, "random seed")->capture_default_str();
+  cmd.add_option("--seed", o.settings.seed, "random seed (0 to 2^64-1)")->check(non_negative())->capture_default_str();
   cmd.add_option("--out", o.out, "image file: .exr, .png or .pfm");
   cmd.add_option("--variance-out", o.variance_out, "variance-of-the-mean image (.exr or .pfm)");
   cmd.add_option("--report", o.report, "run report (.json)");
@@ -59,14 +66,28 @@ void finish_render_options(RenderOptions& o) {
   o.settings.validate();
   for (const std::string* path : {&o.out, &o.variance_out}) {
     if (path->empty()) continue;
-    std::string ext = std::filesystem::path(*path).extension().string();
+    const std::string ext = image_extension(*path);
     if (ext != ".exr" && ext != ".png" && ext != ".pfm")
-      throw InputError(fmt::format("{}: unsupported image type '{}' (use .exr, .png or .pfm)", *path, ext));
+      throw InputError(fmt::format("{}: unsupported image type '{}' (use .exr, .png or .pfm)", display_path(*path),
+                                   std::filesystem::path(*path).extension().string()));
     if (ext != ".pfm" && !image_io_has_oiio())
-      throw InputError(fmt::format("{}: this build has no OpenImageIO (PATHBENCH_OIIO=OFF); write .pfm instead", *path));
+      throw InputError(fmt::format("{}: this build has no OpenImageIO (PATHBENCH_OIIO=OFF); write .pfm instead",
+                                   display_path(*path)));
   }
-  if (!o.report.empty() && std::filesystem::path(o.report).extension() != ".json")
-    throw InputError(fmt::format("--report {}: the report is JSON; name it .json", o.report));
+  if (!o.report.empty() && image_extension(o.report) != ".json")
+    throw InputError(fmt::format("--report {}: the report is JSON; name it .json", display_path(o.report)));
+  // Every output path is checked before the render, so that a bad one fails in
+  // milliseconds and not after the render (and not after another output was written).
+  const std::pair<const char*, const std::string*> outputs[] = {
+      {"--out", &o.out}, {"--variance-out", &o.variance_out}, {"--report", &o.report}};
+  for (size_t i = 0; i < std::size(outputs); ++i) {
+    if (outputs[i].second->empty()) continue;
+    check_output_path(*outputs[i].second, outputs[i].first);
+    for (size_t j = 0; j < i; ++j)
+      if (*outputs[j].second == *outputs[i].second)
+        throw InputError(fmt::format("{} {}: the same file as {}", outputs[i].first, display_path(*outputs[i].second),
+                                     outputs[j].first));
+  }
 }
 
 int run_render(RenderOptions& o) {
@@ -76,9 +97,23 @@ int run_render(RenderOptions& o) {
   RunReport report;
   render_on_device(scene, o.settings, film, report, o.profile);
 
-  if (!o.out.empty()) write_image(o.out, film.mean(), film.width(), film.height());
-  if (!o.variance_out.empty()) write_image(o.variance_out, film.variance_of_mean(), film.width(), film.height());
-  if (!o.report.empty()) write_text_file(o.report, report.to_json().dump(2) + "\n");
+  // Each output goes to its own temporary file; only when all are complete are they
+  // renamed into place, so a failure (a full disk) leaves none of them.
+  std::vector<OutputFile> outputs;
+  outputs.reserve(3);
+  if (!o.out.empty()) write_image(outputs.emplace_back(o.out), film.mean(), film.width(), film.height());
+  if (!o.variance_out.empty())
+    write_image(outputs.emplace_back(o.variance_out), film.variance_of_mean(), film.width(), film.height());
+  if (!o.report.empty()) {
+    // The render's own peak, and the whole run's: the images above (the mean, its
+    // 8-bit copy, the encoder's buffers) can raise the process's peak above the render's.
+    report.extra["render_peak_host_bytes"] = report.peak_host_bytes;
+    report.peak_host_bytes = std::max(report.peak_host_bytes, peak_resident_bytes());
+    OutputFile& f = outputs.emplace_back(o.report);
+    f.write(report.to_json().dump(2) + "\n");
+    f.finish();
+  }
+  for (OutputFile& f : outputs) f.commit();
   if (!o.quiet) {
     fmt::print("{} {}x{} {} spp, {} bounces, {} sampling, {}, {}/{}: {:.3f} s, {:.2f} M rays/s ({} rays, {} paths",
                scene.name, o.settings.width, o.settings.height, o.settings.spp,

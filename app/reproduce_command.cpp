@@ -6,6 +6,7 @@
 #include <chrono>
 #include <vector>
 
+#include "cli_checks.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
@@ -91,9 +92,10 @@ uint32_t reduced_spp_for_budget(const Scene& scene, uint32_t spp, double budget_
 void add_reproduce_options(CLI::App& cmd, ReproduceOptions& o) {
   cmd.add_option("--device", o.device, "cpu, gpu, or all (cpu, plus gpu when there is one)")->capture_default_str();
   cmd.add_option("--out-dir", o.out_dir, "where to write images, reports and the table (default results/<machine>)");
-  cmd.add_option("--spp", o.spp, "samples per pixel (the paper: 800)")->capture_default_str();
+  cmd.add_option("--spp", o.spp, "samples per pixel (the paper: 800)")->check(non_negative())->capture_default_str();
   cmd.add_option("--uniform-spp", o.uniform_spp,
-                 "samples per pixel for the CPU uniform rows (0: --spp, or fewer if --budget needs it); times are scaled to --spp in the table");
+                 "samples per pixel for the CPU uniform rows (0: --spp, or fewer if --budget needs it); times are scaled to --spp in the table")
+      ->check(non_negative());
   cmd.add_option("--budget", o.budget_s,
                  "seconds the CPU rows may take: if the full run would not fit, every CPU row but the image row "
                  "(pixel, nee) runs at fewer spp and its time is scaled; 0: no budget")
@@ -114,6 +116,7 @@ int run_reproduce(const ReproduceOptions& o) {
   if (o.device != "cpu" && have_gpu) devices.push_back(Device::Gpu);
 
   const std::string dir = o.out_dir.empty() ? "results/" + machine_slug() : o.out_dir;
+  check_output_path(dir + "/paper-cornell.md", "--out-dir");  // before minutes of rendering
   const Scene scene = make_paper_cornell();
   const auto t_start = std::chrono::steady_clock::now();
   const bool cpu_rows = devices.front() == Device::Cpu;

@@ -8,9 +8,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <stdexcept>
 
+#include "pathbench/common/errors.h"
+#include "pathbench/common/output_file.h"
+
 #if PATHBENCH_HAVE_OIIO
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 #endif
@@ -31,13 +36,74 @@ float linear_to_srgb(float v) {
 }
 
 // PFM stores rows bottom to top, little-endian when the scale is negative.
-void write_pfm(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", path));
-  out << "PF\n" << w << " " << h << "\n-1.0\n";
-  for (unsigned y = h; y-- > 0;) out.write(reinterpret_cast<const char*>(&rgb[size_t(y) * w * 3]), std::streamsize(w) * 3 * 4);
-  if (!out) throw std::runtime_error(fmt::format("{}: write failed", path));
+void write_pfm(OutputFile& out, const std::vector<float>& rgb, unsigned w, unsigned h) {
+  out.write(fmt::format("PF\n{} {}\n-1.0\n", w, h));
+  for (unsigned y = h; y-- > 0;) out.write(&rgb[size_t(y) * w * 3], size_t(w) * 3 * sizeof(float));
 }
+
+#if PATHBENCH_HAVE_OIIO
+// OpenImageIO writes through this proxy into the OutputFile's descriptor, so every
+// byte it writes is checked (OIIO's own stdio handle loses errors such as a full
+// disk at fclose) and no second handle to the file is opened by name.
+class CheckedProxy final : public OIIO::Filesystem::IOProxy {
+ public:
+  explicit CheckedProxy(OutputFile& f) : IOProxy(f.temp_path(), Write), file_(f) {}
+  const char* proxytype() const override { return "pathbench-output"; }
+  size_t write(const void* buf, size_t n) override {
+    const size_t done = pwrite(buf, n, m_pos);
+    m_pos += int64_t(done);
+    return done;
+  }
+  size_t pwrite(const void* buf, size_t n, int64_t offset) override {
+    if (!file_.write_at(buf, n, off_t(offset))) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!error_) error_ = errno;
+      return 0;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    size_ = std::max(size_, size_t(offset) + n);
+    return n;
+  }
+  size_t size() const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return size_;
+  }
+  int error_number() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return error_;
+  }
+
+ private:
+  OutputFile& file_;
+  mutable std::mutex mutex_;
+  size_t size_ = 0;
+  int error_ = 0;
+};
+
+void write_oiio(OutputFile& f, const std::string& ext, const std::vector<float>& rgb, unsigned w, unsigned h) {
+  using namespace OIIO;
+  const std::string& path = f.path();
+  auto out = ImageOutput::create(ext.substr(1));  // the format by its (lower-case) name
+  if (!out) throw InputError(fmt::format("{}: OpenImageIO cannot write this format ({})", display_path(path), OIIO::geterror()));
+  if (!out->supports("ioproxy"))
+    throw InputError(fmt::format("{}: OpenImageIO cannot write '{}' through a checked handle; use .exr, .png or .pfm",
+                                 display_path(path), ext));
+  CheckedProxy proxy(f);
+  const bool eight_bit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  ImageSpec spec(int(w), int(h), 3, eight_bit ? TypeDesc::UINT8 : TypeDesc::FLOAT);
+  bool ok = out->set_ioproxy(&proxy) && out->open(f.temp_path(), spec);
+  if (ok && eight_bit) {
+    std::vector<unsigned char> px(rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i) px[i] = (unsigned char)std::lround(linear_to_srgb(rgb[i]) * 255.0f);
+    ok = out->write_image(TypeDesc::UINT8, px.data());
+  } else if (ok) {
+    ok = out->write_image(TypeDesc::FLOAT, rgb.data());
+  }
+  ok = out->close() && ok;
+  if (proxy.error_number()) f.fail("write failed", proxy.error_number());
+  if (!ok) throw InputError(fmt::format("{}: {}", display_path(path), out->geterror()));
+}
+#endif
 
 std::vector<float> read_pfm(const std::string& path, unsigned& w, unsigned& h) {
   std::ifstream in(path, std::ios::binary);
@@ -57,41 +123,30 @@ std::vector<float> read_pfm(const std::string& path, unsigned& w, unsigned& h) {
 
 bool image_io_has_oiio() { return PATHBENCH_HAVE_OIIO; }
 
-void write_image(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h) {
+std::string image_extension(const std::string& path) { return extension_of(path); }
+
+void write_image(OutputFile& out, const std::vector<float>& rgb, unsigned w, unsigned h) {
+  const std::string& path = out.path();
   if (rgb.size() != size_t(w) * h * 3) throw std::runtime_error(fmt::format("{}: image buffer has the wrong size", path));
   const std::string ext = extension_of(path);
-  const std::filesystem::path final_path(path);
-  if (final_path.has_parent_path()) std::filesystem::create_directories(final_path.parent_path());
-  const std::string tmp = path + ".tmp" + ext;
   if (ext == ".pfm") {
-    write_pfm(tmp, rgb, w, h);
+    write_pfm(out, rgb, w, h);
   } else {
 #if PATHBENCH_HAVE_OIIO
-    using namespace OIIO;
-    auto out = ImageOutput::create(path);
-    if (!out) throw std::runtime_error(fmt::format("{}: OpenImageIO cannot write this format ({})", path, OIIO::geterror()));
-    const bool eight_bit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
-    ImageSpec spec(int(w), int(h), 3, eight_bit ? TypeDesc::UINT8 : TypeDesc::FLOAT);
-    if (!out->open(tmp, spec)) throw std::runtime_error(fmt::format("{}: {}", path, out->geterror()));
-    bool ok;
-    if (eight_bit) {
-      std::vector<unsigned char> px(rgb.size());
-      for (size_t i = 0; i < rgb.size(); ++i) px[i] = (unsigned char)std::lround(linear_to_srgb(rgb[i]) * 255.0f);
-      ok = out->write_image(TypeDesc::UINT8, px.data());
-    } else {
-      ok = out->write_image(TypeDesc::FLOAT, rgb.data());
-    }
-    if (!ok || !out->close()) {
-      std::filesystem::remove(tmp);
-      throw std::runtime_error(fmt::format("{}: {}", path, out->geterror()));
-    }
+    write_oiio(out, ext, rgb, w, h);
 #else
-    throw std::runtime_error(fmt::format(
+    throw InputError(fmt::format(
         "{}: this build has no OpenImageIO (PATHBENCH_OIIO=OFF), so it cannot write '{}' files; write .pfm instead",
-        path, ext));
+        display_path(path), ext));
 #endif
   }
-  std::filesystem::rename(tmp, path);
+  out.finish();
+}
+
+void write_image(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h) {
+  OutputFile out(path);
+  write_image(out, rgb, w, h);
+  out.commit();
 }
 
 std::vector<float> read_image(const std::string& path, unsigned& w, unsigned& h) {

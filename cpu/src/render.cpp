@@ -4,6 +4,7 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
@@ -36,7 +37,10 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress, isa};
 
   const auto t0 = std::chrono::steady_clock::now();
-  const uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads);
+  // A pool larger than the frame's samples would only hold empty slots (--paths-in-flight 1e8 for 64
+  // samples once took 10 GB).
+  const uint64_t pif = std::min(settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads),
+                                std::max<uint64_t>(1, settings.total_samples()));
   const bool dbl = settings.precision == Precision::Double;
   TraceTotals totals;
   if (settings.strategy == Strategy::Pixel) {

@@ -12,6 +12,7 @@
 // Compiled for one set of material kinds per translation unit (PB_CPU_KINDS,
 // features.h): diffuse-only here, every kind in render_wavefront_all_kinds.cpp, so the
 // diffuse-only code compiles exactly as in a build without the other kinds.
+#include <fmt/core.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -19,9 +20,11 @@
 #include <algorithm>
 #include <memory>
 #include <type_traits>
+#include <unistd.h>
 #include <vector>
 
 #include "embree_rays.h"
+#include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
 #include "strategies.h"
@@ -330,6 +333,13 @@ TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const Batch
   SampleSource source(uint64_t(pixels) * job.spp, pixels);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
+  // A pool that cannot fit is a setting to lower, not a std::bad_alloc (exit 2, not 1).
+  const double pool_bytes = double(per_slice) * slices * double(PoolSlice<T>::bytes_per_path);
+  const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
+  if (memory > 0 && pool_bytes > memory / 2)
+    throw InputError(fmt::format("--paths-in-flight {}: the path pool would take {:.1f} GB, more than half of this "
+                                 "machine's {:.1f} GB of memory; lower it (0 picks a default)",
+                                 paths_in_flight, pool_bytes / 1e9, memory / 1e9));
   tbb::combinable<Local> locals;
   tbb::parallel_for(0, slices, [&](int) {
     Local& local = locals.local();

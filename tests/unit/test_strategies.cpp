@@ -175,5 +175,19 @@ TEST(Strategies, SameSeedTwiceIsIdentical) {
   expect_identical(render_cornell(s).film, render_cornell(s).film, "wavefront, run twice");
 }
 
+// --paths-in-flight is clamped to the frame's samples: 10^8 paths for 64 samples once
+// allocated 10 GB. The pool then holds at most a packet per thread.
+TEST(Strategies, PathsInFlightClampedToTheFrame) {
+  RenderSettings s = base_settings(Sampling::Nee, 2);
+  s.width = s.height = 8;
+  s.spp = 1;
+  s.threads = 2;
+  s.strategy = Strategy::Wavefront;
+  s.paths_in_flight = 100000000;
+  const Rendered r = render_cornell(s);
+  EXPECT_EQ(r.report.paths, s.total_samples());
+  EXPECT_LT(r.report.paths_in_flight, 100000u) << "the pool was sized by the setting, not the frame";
+}
+
 }  // namespace
 }  // namespace pb

@@ -7,12 +7,20 @@
 
 namespace pb {
 
+class OutputFile;
+
 bool image_io_has_oiio();
+// The file name's extension in lower case (".exr"); ".EXR" names the same format.
+std::string image_extension(const std::string& path);
 // Writes RGB float pixels, row 0 at the top. The format follows the file name's
-// extension (.exr, .png, .pfm, and what OpenImageIO supports). Writes to a temporary
-// file and renames it, so a failure leaves nothing half-written. Throws
-// std::runtime_error with the path and reason on failure.
+// extension (.exr, .png, .pfm; OpenImageIO's other formats where it can write them
+// through a checked handle). Writes to a temporary file (OutputFile: every write
+// checked, fsync) and renames it, so a failure leaves nothing. Throws InputError
+// with the path and reason on failure (a full disk, a folder that cannot be written).
 void write_image(const std::string& path, const std::vector<float>& rgb, unsigned width, unsigned height);
+// The same into `out`, finished but not committed: the caller renames it into place
+// with out.commit(), e.g. once every output of a run has been written.
+void write_image(OutputFile& out, const std::vector<float>& rgb, unsigned width, unsigned height);
 // Reads an RGB float image (.pfm always; others through OpenImageIO).
 std::vector<float> read_image(const std::string& path, unsigned& width, unsigned& height);
 
