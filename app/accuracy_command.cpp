@@ -15,6 +15,7 @@
 #include "accuracy_reference.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
 
@@ -80,13 +81,6 @@ std::vector<Config> selected_configs(const std::string& list) {
     }
   }
   return out;
-}
-
-nlohmann::json load_average() {
-  std::ifstream in("/proc/loadavg");
-  double a = 0, b = 0, c = 0;
-  if (!(in >> a >> b >> c)) return nullptr;
-  return {a, b, c};
 }
 
 std::string utc_now() {
@@ -205,6 +199,7 @@ int run_accuracy(AccuracyOptions& o) {
   out["compiler"] = compiler_id();
   out["machine"] = {{"slug", machine_folder(base.device)}, {"cpu", cpu_model()}, {"hardware_threads", hardware_threads()}};
   out["load_average_at_start"] = load_average();
+  out["fingerprint"] = run_fingerprint(base.device == Device::Gpu);
   out["ladder"] = {{"max_spp", o.max_spp}, {"max_seconds", o.max_seconds}, {"factor", 4}};
   out["metrics"] = {
       {"rmse", "sqrt(mean over pixel-channels of (x - ref)^2)"},

@@ -2,7 +2,6 @@
 
 #include <fmt/core.h>
 
-#include <cctype>
 #include <filesystem>
 #include <fstream>
 
@@ -10,6 +9,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/image_io.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/report.h"
 
 namespace pb::app {
@@ -42,15 +42,7 @@ bool try_load(const std::string& dir, const std::string& stem, const RenderSetti
 }
 }  // namespace
 
-std::string file_slug(const std::string& name) {
-  std::string out;
-  for (char c : name) {
-    if (std::isalnum(static_cast<unsigned char>(c))) out += char(std::tolower(static_cast<unsigned char>(c)));
-    else if (!out.empty() && out.back() != '-') out += '-';
-  }
-  while (!out.empty() && out.back() == '-') out.pop_back();
-  return out.empty() ? "scene" : out;
-}
+std::string file_slug(const std::string& name) { return slugify(name, "scene"); }
 
 bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
                                std::string& refusal) {

@@ -120,19 +120,23 @@ double unit_to_seconds(const std::string& unit, const std::string& path, const s
 
 }  // namespace
 
+nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const std::string& path) {
+  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
+  // counter); strict JSON has no NaN, so such values are read as null.
+  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
+  try {
+    return nlohmann::ordered_json::parse(std::regex_replace(raw, non_finite, "$1null"));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
+  }
+}
+
 nlohmann::json read_benchmark_json(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file", path));
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("{}: cannot be read", path));
-  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
-  // counter); strict JSON has no NaN, so such values are read as null.
   const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
-  try {
-    return nlohmann::json::parse(std::regex_replace(raw, non_finite, "$1null"));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
-  }
+  return nlohmann::json(parse_benchmark_json_text(raw, path));
 }
 
 BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {

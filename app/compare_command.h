@@ -49,6 +49,9 @@ struct BenchFile {
   std::map<std::string, BenchSeries> series;
   std::vector<std::string> order;
 };
+// Google Benchmark JSON text parsed with its bare NaN / inf values read as null, keys
+// in file order. Throws InputError naming `path` when it is not JSON.
+nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const std::string& path);
 // The file as JSON, with Google Benchmark's bare NaN / inf values read as null.
 // Throws InputError when it is missing or not JSON.
 nlohmann::json read_benchmark_json(const std::string& path);

@@ -12,7 +12,9 @@
 //   materials  diffuse-only against mirror/glass/GGX scenes (materials_bench.h).
 //
 // Regression runs: --benchmark_repetitions=9 --benchmark_report_aggregates_only=false
-// --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`.
+// --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`. That file is
+// strict JSON with the machine fingerprint (bench_context.h); JSON on stdout
+// (--benchmark_format=json) is Google Benchmark's own, NaN included.
 #include <benchmark/benchmark.h>
 #include <fmt/core.h>
 
@@ -139,8 +141,24 @@ int main(int argc, char** argv) {
   args.push_back(nullptr);
   benchmark::Initialize(&new_argc, args.data());
   if (benchmark::ReportUnrecognizedArguments(new_argc, args.data())) return 2;
+  // The output file (--benchmark_out=PATH, JSON unless another format is asked for) is
+  // rewritten after the run as strict JSON with the fingerprint and the end-of-run load.
+  std::string out_path, out_format = "json";
+  for (int i = 1; i < new_argc; ++i) {
+    const std::string a = args[i];
+    if (a.rfind("--benchmark_out=", 0) == 0) out_path = a.substr(16);
+    if (a.rfind("--benchmark_out_format=", 0) == 0) out_format = a.substr(23);
+  }
   pb::bench::add_environment_context(preset);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  if (!out_path.empty() && out_format == "json") {
+    try {
+      pb::bench::finish_benchmark_json(out_path);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
+      return 1;
+    }
+  }
   return 0;
 }
