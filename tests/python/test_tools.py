@@ -98,3 +98,27 @@ def test_speed_markdown_with_raw_embree():
     md = mitsuba_speed.markdown(res)
     assert "| pixel | 52.0 M / 50.0 M / 85.0 M | rtcIntersect1 / rtcOccluded1 | 16.0 M | 12.0 M | 75% |" in md
     assert "intersect1/coherent 20.0" in md
+
+
+def test_machine_id_agrees_with_the_render_report(tmp_path):
+    """tools/machine.py and pathbench's C++ fingerprint name this machine alike (fixture
+    machines: tests/bench/test_fingerprint.cpp)."""
+    import json
+    import subprocess
+    from pathlib import Path
+    exe = Path(__file__).resolve().parents[2] / "build" / "bin" / "pathbench"
+    if not exe.exists():
+        pytest.skip("build/bin/pathbench not built")
+    report = tmp_path / "r.json"
+    subprocess.run([str(exe), "render", "--scene", "paper-cornell", "--width", "8", "--height", "8", "--spp", "1",
+                    "--quiet", "--report", str(report)], check=True)
+    fp = json.loads(report.read_text())["fingerprint"]
+    host = machine.host_fingerprint()
+    assert fp["machine_id"] == host["machine_id"]
+    assert fp["cpu"] == host["cpu"]
+
+
+def test_slugify_is_the_cpp_rule():
+    assert machine.slugify("cornell-box:mirror", "x") == "cornell-box-mirror"
+    assert machine.slugify("caf\u00e9 GPU", "x") == "caf-gpu"
+    assert machine.slugify(" -- ", "scene") == "scene"
