@@ -137,18 +137,19 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling or materials)\n", preset);
     return 2;
   }
-  int new_argc = int(args.size());
-  args.push_back(nullptr);
-  benchmark::Initialize(&new_argc, args.data());
-  if (benchmark::ReportUnrecognizedArguments(new_argc, args.data())) return 2;
   // The output file (--benchmark_out=PATH, JSON unless another format is asked for) is
   // rewritten after the run as strict JSON with the fingerprint and the end-of-run load.
+  // Read before Initialize, which removes the flags it knows from argv.
   std::string out_path, out_format = "json";
-  for (int i = 1; i < new_argc; ++i) {
+  for (size_t i = 1; i < args.size(); ++i) {
     const std::string a = args[i];
     if (a.rfind("--benchmark_out=", 0) == 0) out_path = a.substr(16);
     if (a.rfind("--benchmark_out_format=", 0) == 0) out_format = a.substr(23);
   }
+  int new_argc = int(args.size());
+  args.push_back(nullptr);
+  benchmark::Initialize(&new_argc, args.data());
+  if (benchmark::ReportUnrecognizedArguments(new_argc, args.data())) return 2;
   pb::bench::add_environment_context(preset);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
