@@ -70,6 +70,7 @@ void add_environment_context(const std::string& preset) {
   if (fp.contains("gpu") && fp["gpu"].contains("name")) {
     add("gpu_name", fp["gpu"]["name"].get<std::string>());
     add("gpu_driver", fp["gpu"]["driver"].get<std::string>());
+    add("cuda_runtime", fp["gpu"]["cuda_runtime"].get<std::string>());
   } else {
     add("gpu", fp.contains("gpu") ? "none: " + fp["gpu"].value("none", std::string("?"))
                                   : std::string("none (built without the CUDA tracer)"));
