@@ -180,7 +180,7 @@ int run_accuracy(AccuracyOptions& o) {
   }
   const Scene scene = load_scene(o.scene);
   const std::string dir = o.out_dir.empty() ? "results/" + machine_folder(base.device) + "/accuracy" : o.out_dir;
-  const std::string stem = fmt::format("{}-{}x{}-{}", file_slug(scene.name), o.width, o.height, to_string(base.device));
+  const std::string stem = fmt::format("{}-{}x{}-{}", slugify(scene.name, "scene"), o.width, o.height, to_string(base.device));
   const std::string image_dir = "images/" + stem;
   fs::create_directories(fs::path(dir) / image_dir);
   // Per-render images are for the report tool (FLIP), not for the repository.

@@ -21,7 +21,7 @@ namespace {
 constexpr uint64_t kReferenceSeed = 0x7265666572656e63ull;  // "referenc"
 
 std::string stem_of(const Scene& scene, const RenderSettings& s) {
-  return fmt::format("reference-{}-{}x{}-{}-{}spp-v{}", file_slug(scene.name), s.width, s.height, to_string(s.device),
+  return fmt::format("reference-{}-{}x{}-{}-{}spp-v{}", slugify(scene.name, "scene"), s.width, s.height, to_string(s.device),
                      s.spp, kReferenceVersion);
 }
 
@@ -41,8 +41,6 @@ bool try_load(const std::string& dir, const std::string& stem, const RenderSetti
   return true;
 }
 }  // namespace
-
-std::string file_slug(const std::string& name) { return slugify(name, "scene"); }
 
 bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
                                std::string& refusal) {

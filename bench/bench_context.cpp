@@ -57,7 +57,8 @@ void add_environment_context(const std::string& preset) {
   add("cpu_hardware_threads", std::to_string(hardware_threads()));
   add("cpu_tbb_threads", std::to_string(tbb::this_task_arena::max_concurrency()));
   add("machine", machine_slug());  // results/<machine>/ folder; the identity is machine_id
-  add("compiler", build["compiler"].get<std::string>());
+  // As before the fingerprint ("GNU 12.2.0 (gcc 12.2.0)"), so old and new files agree.
+  add("compiler", fmt::format("{} ({})", build["cmake_compiler"].get<std::string>(), build["compiler"].get<std::string>()));
   add("cxx_flags", build["cxx_flags"].get<std::string>());
   add("build_type", build["build_type"].get<std::string>());
   add("embree_version", fp["libraries"]["embree"].get<std::string>());

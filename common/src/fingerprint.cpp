@@ -19,6 +19,9 @@
 #ifndef PATHBENCH_CXX_FLAGS
 #define PATHBENCH_CXX_FLAGS "unknown"
 #endif
+#ifndef PATHBENCH_CMAKE_COMPILER
+#define PATHBENCH_CMAKE_COMPILER "unknown"
+#endif
 #ifndef PATHBENCH_BUILD_TYPE
 #define PATHBENCH_BUILD_TYPE "unknown"
 #endif
@@ -65,6 +68,7 @@ nlohmann::json isa_compiled() {
 nlohmann::json build_facts() {
   nlohmann::json b;
   b["compiler"] = compiler_id();
+  b["cmake_compiler"] = PATHBENCH_CMAKE_COMPILER;  // CMake's id and version, e.g. "GNU 12.2.0"
   b["cxx_flags"] = PATHBENCH_CXX_FLAGS;
   b["build_type"] = PATHBENCH_BUILD_TYPE;
   b["isa_compiled"] = isa_compiled();
