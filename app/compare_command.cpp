@@ -267,7 +267,7 @@ std::vector<CompareRow> compare_files(const BenchFile& base, const BenchFile& ne
         // Slower in wall time: contended when the work (CPU time of every thread) did
         // not grow with it, i.e. the process waited for cores it did not get.
         // "Flat" is relative: sharing cores and caches with another process costs some
-        // CPU time too (+9% in tests/data/bench/quick-contended.json), so the test is
+        // CPU time too (+17% and +35% in tests/data/bench/quick-contended.json), so the test is
         // that less than half of the slowdown is more work.
         const bool cpu_flat = row.has_cpu && row.cpu_change < row.time_change / 2;
         row.verdict = cpu_flat ? Verdict::Contended : Verdict::Regressed;

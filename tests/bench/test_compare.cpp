@@ -191,8 +191,8 @@ TEST(CompareContext, OtherLayoutWarnsAndStrictRefuses) {
 }
 
 // Two real runs of the same binary (tests/data/bench/README.md): the second with eight
-// busy loops beside it. Wall time went up several-fold, CPU time did not: contended, not
-// a regression; --strict refuses the pair.
+// busy loops beside it. Wall time went up 12-17 fold, CPU time by a sixth to a third:
+// contended, not a regression; --strict refuses the pair.
 TEST(CompareContext, RealContendedRunIsFlaggedContended) {
   auto rows = pb::app::compare_files(pb::app::load_benchmark_json(kData + "quick-quiet.json", 9),
                                      pb::app::load_benchmark_json(kData + "quick-contended.json", 9), 0.05, 0.05);
