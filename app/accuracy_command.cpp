@@ -16,6 +16,7 @@
 #include "cli_checks.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
 
@@ -81,13 +82,6 @@ std::vector<Config> selected_configs(const std::string& list) {
     }
   }
   return out;
-}
-
-nlohmann::json load_average() {
-  std::ifstream in("/proc/loadavg");
-  double a = 0, b = 0, c = 0;
-  if (!(in >> a >> b >> c)) return nullptr;
-  return {a, b, c};
 }
 
 std::string utc_now() {
@@ -187,7 +181,7 @@ int run_accuracy(AccuracyOptions& o) {
   }
   const Scene scene = load_scene(o.scene);
   const std::string dir = o.out_dir.empty() ? "results/" + machine_folder(base.device) + "/accuracy" : o.out_dir;
-  const std::string stem = fmt::format("{}-{}x{}-{}", file_slug(scene.name), o.width, o.height, to_string(base.device));
+  const std::string stem = fmt::format("{}-{}x{}-{}", slugify(scene.name, "scene"), o.width, o.height, to_string(base.device));
   const std::string image_dir = "images/" + stem;
   check_output_path((fs::path(dir) / (stem + ".json")).string(), "--out-dir");  // before the sweep
   fs::create_directories(fs::path(dir) / image_dir);
@@ -207,6 +201,7 @@ int run_accuracy(AccuracyOptions& o) {
   out["compiler"] = compiler_id();
   out["machine"] = {{"slug", machine_folder(base.device)}, {"cpu", cpu_model()}, {"hardware_threads", hardware_threads()}};
   out["load_average_at_start"] = load_average();
+  out["fingerprint"] = run_fingerprint(base.device == Device::Gpu);
   out["ladder"] = {{"max_spp", o.max_spp}, {"max_seconds", o.max_seconds}, {"factor", 4}};
   out["metrics"] = {
       {"rmse", "sqrt(mean over pixel-channels of (x - ref)^2)"},

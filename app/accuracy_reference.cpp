@@ -2,7 +2,6 @@
 
 #include <fmt/core.h>
 
-#include <cctype>
 #include <filesystem>
 #include <fstream>
 
@@ -10,6 +9,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/image_io.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/report.h"
 
 namespace pb::app {
@@ -21,7 +21,7 @@ namespace {
 constexpr uint64_t kReferenceSeed = 0x7265666572656e63ull;  // "referenc"
 
 std::string stem_of(const Scene& scene, const RenderSettings& s) {
-  return fmt::format("reference-{}-{}x{}-{}-{}spp-v{}", file_slug(scene.name), s.width, s.height, to_string(s.device),
+  return fmt::format("reference-{}-{}x{}-{}-{}spp-v{}", slugify(scene.name, "scene"), s.width, s.height, to_string(s.device),
                      s.spp, kReferenceVersion);
 }
 
@@ -41,16 +41,6 @@ bool try_load(const std::string& dir, const std::string& stem, const RenderSetti
   return true;
 }
 }  // namespace
-
-std::string file_slug(const std::string& name) {
-  std::string out;
-  for (char c : name) {
-    if (std::isalnum(static_cast<unsigned char>(c))) out += char(std::tolower(static_cast<unsigned char>(c)));
-    else if (!out.empty() && out.back() != '-') out += '-';
-  }
-  while (!out.empty() && out.back() == '-') out.pop_back();
-  return out.empty() ? "scene" : out;
-}
 
 bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
                                std::string& refusal) {

@@ -35,9 +35,6 @@ bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film
 // The reference's settings: `base` supplies size, device, strategy and threads.
 RenderSettings reference_settings(const RenderSettings& base, uint32_t spp);
 
-// A file-name-safe form of a scene name ("scenes/box.json" -> "scenes-box-json").
-std::string file_slug(const std::string& name);
-
 // Loads the cached reference from `dir`, or renders it there (also when
 // `regenerate`). `progress` shows the render's progress bar.
 Reference load_or_render_reference(const Scene& scene, const RenderSettings& base, uint32_t spp,

@@ -11,6 +11,7 @@
 #include <numeric>
 #include <regex>
 
+#include "compare_context.h"
 #include "pathbench/common/errors.h"
 
 namespace pb::app {
@@ -22,7 +23,10 @@ void add_compare_options(CLI::App& cmd, CompareOptions& o) {
       ->capture_default_str();
   cmd.add_option("--alpha", o.alpha, "significance level of the two-sided Mann-Whitney U test")->capture_default_str();
   cmd.add_option("--min-repetitions", o.min_repetitions, "repetitions each benchmark needs")->capture_default_str();
-  cmd.add_flag("--quiet", o.quiet, "print only the verdict");
+  cmd.add_flag("--quiet", o.quiet, "print only the verdict (text format)");
+  cmd.add_flag("--strict", o.strict,
+               "refuse (exit 2) when the runs differ in machine fingerprint, build, settings, Embree layout or load");
+  cmd.add_option("--format", o.format, "text, json or markdown")->capture_default_str();
 }
 
 double median(std::vector<double> v) {
@@ -120,19 +124,23 @@ double unit_to_seconds(const std::string& unit, const std::string& path, const s
 
 }  // namespace
 
+nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const std::string& path) {
+  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
+  // counter); strict JSON has no NaN, so such values are read as null.
+  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
+  try {
+    return nlohmann::ordered_json::parse(std::regex_replace(raw, non_finite, "$1null"));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
+  }
+}
+
 nlohmann::json read_benchmark_json(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file", path));
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("{}: cannot be read", path));
-  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
-  // counter); strict JSON has no NaN, so such values are read as null.
   const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
-  try {
-    return nlohmann::json::parse(std::regex_replace(raw, non_finite, "$1null"));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
-  }
+  return nlohmann::json(parse_benchmark_json_text(raw, path));
 }
 
 BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
@@ -143,6 +151,7 @@ BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
                                  path));
   BenchFile f;
   f.path = path;
+  f.context = j["context"].is_object() ? j["context"] : nlohmann::json::object();
   std::map<std::string, bool> has_aggregates;
   for (const auto& b : j["benchmarks"]) {
     if (!b.is_object() || !b.contains("name"))
@@ -166,6 +175,18 @@ BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
     s.seconds.push_back(b["real_time"].get<double>() * scale);
     if (b.contains("rays_per_second") && b["rays_per_second"].is_number())
       s.rays_per_second.push_back(b["rays_per_second"].get<double>());
+    if (b.contains("process_cpu_seconds") && b["process_cpu_seconds"].is_number()) {
+      s.cpu_seconds.push_back(b["process_cpu_seconds"].get<double>());
+      s.cpu_is_process = true;
+    } else if (b.contains("cpu_time") && b["cpu_time"].is_number()) {
+      s.cpu_seconds.push_back(b["cpu_time"].get<double>() * scale);
+    }
+    if (b.contains("label") && b["label"].is_string() && !b["label"].get<std::string>().empty())
+      s.labels.insert(b["label"].get<std::string>());
+    // A counter named like Google Benchmark's own "threads" key was a duplicate key in
+    // older files; parsing keeps the last, which was the counter.
+    for (const char* k : {"cpu_threads", "threads"})
+      if (b.contains(k) && b[k].is_number() && s.cpu_threads < 0) s.cpu_threads = b[k].get<double>();
   }
   if (f.series.empty()) throw InputError(fmt::format("{}: the file lists no benchmarks", path));
   for (const auto& name : f.order) {
@@ -188,6 +209,8 @@ const char* to_string(Verdict v) {
     case Verdict::Same: return "same";
     case Verdict::Regressed: return "REGRESSED";
     case Verdict::Improved: return "improved";
+    case Verdict::Contended: return "contended";
+    case Verdict::Invalid: return "invalid";
     case Verdict::Error: return "error";
     case Verdict::OnlyBase: return "only in base";
     case Verdict::OnlyNew: return "only in new";
@@ -216,69 +239,94 @@ std::vector<CompareRow> compare_files(const BenchFile& base, const BenchFile& ne
       const BenchSeries &b = bi->second, &n = ni->second;
       row.base_median_s = median(b.seconds);
       row.new_median_s = median(n.seconds);
-      row.time_change = row.base_median_s > 0 ? row.new_median_s / row.base_median_s - 1 : 0;
+      if (!(row.base_median_s > 0) || !(row.new_median_s > 0)) {
+        // A zero time is no measurement: "improved -100%" would be a lie.
+        row.verdict = Verdict::Invalid;
+        row.note = fmt::format("median time is zero in {}", row.base_median_s > 0 ? "new" : "base");
+        rows.push_back(row);
+        continue;
+      }
+      row.time_change = row.new_median_s / row.base_median_s - 1;
       if (!b.rays_per_second.empty() && !n.rays_per_second.empty()) {
         const double rb = median(b.rays_per_second), rn = median(n.rays_per_second);
         row.has_rays = rb > 0;
         row.rays_change = rb > 0 ? rn / rb - 1 : 0;
       }
+      if (!b.cpu_seconds.empty() && !n.cpu_seconds.empty() && b.cpu_is_process == n.cpu_is_process) {
+        row.base_cpu_s = median(b.cpu_seconds);
+        row.new_cpu_s = median(n.cpu_seconds);
+        row.has_cpu = row.base_cpu_s > 0 && row.new_cpu_s > 0;
+        if (row.has_cpu) {
+          row.cpu_change = row.new_cpu_s / row.base_cpu_s - 1;
+          row.diverges = std::fabs(row.time_change - row.cpu_change) > std::max(threshold, 0.05);
+        }
+      }
       row.test = mann_whitney_u(n.seconds, b.seconds);
       const bool significant = row.test.p < alpha;
-      if (significant && row.time_change > threshold) row.verdict = Verdict::Regressed;
-      else if (significant && row.time_change < -threshold) row.verdict = Verdict::Improved;
-      else row.verdict = Verdict::Same;
+      if (significant && row.time_change > threshold) {
+        // Slower in wall time: contended when the work (CPU time of every thread) did
+        // not grow with it, i.e. the process waited for cores it did not get.
+        // "Flat" is relative: sharing cores and caches with another process costs some
+        // CPU time too (+17% and +35% in tests/data/bench/quick-contended.json), so the test is
+        // that less than half of the slowdown is more work.
+        const bool cpu_flat = row.has_cpu && row.cpu_change < row.time_change / 2;
+        row.verdict = cpu_flat ? Verdict::Contended : Verdict::Regressed;
+        if (cpu_flat)
+          row.note = fmt::format("wall {:+.1f}%, CPU {:+.1f}%: waited for cores", 100 * row.time_change,
+                                 100 * row.cpu_change);
+      } else if (significant && row.time_change < -threshold) {
+        row.verdict = Verdict::Improved;
+      } else {
+        row.verdict = Verdict::Same;
+      }
+      if (row.diverges && row.note.empty())
+        row.note = fmt::format("wall {:+.1f}% but CPU {:+.1f}%", 100 * row.time_change, 100 * row.cpu_change);
     }
     rows.push_back(row);
   }
   return rows;
 }
 
-namespace {
-std::string fmt_time(double s) {
-  if (s >= 1) return fmt::format("{:.3f} s", s);
-  if (s >= 1e-3) return fmt::format("{:.3f} ms", s * 1e3);
-  if (s >= 1e-6) return fmt::format("{:.3f} us", s * 1e6);
-  return fmt::format("{:.1f} ns", s * 1e9);
-}
-}  // namespace
-
-std::string format_table(const std::vector<CompareRow>& rows, double threshold, double alpha) {
-  size_t w = 9;
-  for (const auto& r : rows) w = std::max(w, r.name.size());
-  std::string out = fmt::format("{:<{}}  {:>12}  {:>12}  {:>8}  {:>8}  {:>9}  {}\n", "benchmark", w, "base median",
-                                "new median", "time", "rays/s", "p (U)", "verdict");
-  out += std::string(w + 2 + 12 + 2 + 12 + 2 + 8 + 2 + 8 + 2 + 9 + 2 + 9, '-') + "\n";
-  int regressed = 0, improved = 0;
-  for (const auto& r : rows) {
-    if (r.verdict == Verdict::OnlyBase || r.verdict == Verdict::OnlyNew || r.verdict == Verdict::Error) {
-      out += fmt::format("{:<{}}  {:>12}  {:>12}  {:>8}  {:>8}  {:>9}  {}{}\n", r.name, w, "", "", "", "", "",
-                         to_string(r.verdict), r.note.empty() ? "" : ": " + r.note);
-      continue;
-    }
-    regressed += r.verdict == Verdict::Regressed;
-    improved += r.verdict == Verdict::Improved;
-    out += fmt::format("{:<{}}  {:>12}  {:>12}  {:>+7.1f}%  {:>8}  {:>9.2g}  {}\n", r.name, w, fmt_time(r.base_median_s),
-                       fmt_time(r.new_median_s), 100 * r.time_change,
-                       r.has_rays ? fmt::format("{:+.1f}%", 100 * r.rays_change) : std::string("-"), r.test.p,
-                       to_string(r.verdict));
-  }
-  out += fmt::format(
-      "\n{} benchmark(s): {} regressed, {} improved (regressed = two-sided Mann-Whitney U p < {} and median time "
-      "more than {:.1f}% slower)\n",
-      rows.size(), regressed, improved, alpha, 100 * threshold);
-  return out;
+int count_verdict(const std::vector<CompareRow>& rows, Verdict v) {
+  return int(std::count_if(rows.begin(), rows.end(), [v](const CompareRow& r) { return r.verdict == v; }));
 }
 
 int run_compare(const CompareOptions& o) {
   if (!(o.threshold >= 0)) throw InputError("--threshold: must be >= 0");
   if (!(o.alpha > 0 && o.alpha < 1)) throw InputError("--alpha: must be in (0, 1)");
   if (o.min_repetitions < 2) throw InputError("--min-repetitions: must be at least 2");
+  if (o.format != "text" && o.format != "json" && o.format != "markdown")
+    throw InputError(fmt::format("--format: unknown format '{}' (expected text, json or markdown)", o.format));
   const BenchFile base = load_benchmark_json(o.base, o.min_repetitions);
   const BenchFile next = load_benchmark_json(o.next, o.min_repetitions);
-  const auto rows = compare_files(base, next, o.threshold, o.alpha);
-  const bool any = std::any_of(rows.begin(), rows.end(), [](auto& r) { return r.verdict == Verdict::Regressed; });
-  if (!o.quiet) fmt::print("base: {}\nnew:  {}\n\n{}", o.base, o.next, format_table(rows, o.threshold, o.alpha));
-  fmt::print("{}\n", any ? "pathbench compare: REGRESSION" : "pathbench compare: no regression");
+  CompareReport rep;
+  rep.base_path = o.base;
+  rep.new_path = o.next;
+  rep.threshold = o.threshold;
+  rep.alpha = o.alpha;
+  rep.rows = compare_files(base, next, o.threshold, o.alpha);
+  const int matched = int(rep.rows.size()) - count_verdict(rep.rows, Verdict::OnlyBase) -
+                      count_verdict(rep.rows, Verdict::OnlyNew);
+  if (matched == 0)
+    throw InputError(fmt::format("{} and {} have no benchmark name in common: nothing to compare", o.base, o.next));
+  if (count_verdict(rep.rows, Verdict::Invalid) + count_verdict(rep.rows, Verdict::Error) == matched)
+    throw InputError(fmt::format("{} / {}: no benchmark in common has a usable time (zero times or errors)",
+                                 o.base, o.next));
+  describe_runs(base, next, rep);
+  if (o.strict && !rep.warnings.empty()) {
+    for (const auto& w : rep.warnings) fmt::print(stderr, "warning: {}\n", w);
+    throw InputError(fmt::format("--strict: the runs differ ({} warning(s) above); not comparing",
+                                 rep.warnings.size()));
+  }
+  const bool any = count_verdict(rep.rows, Verdict::Regressed) > 0;
+  if (o.format == "json") {
+    fmt::print("{}\n", format_json(rep).dump(2));
+  } else if (o.format == "markdown") {
+    fmt::print("{}", format_markdown(rep));
+  } else {
+    if (!o.quiet) fmt::print("{}", format_text(rep));
+    fmt::print("{}\n", any ? "pathbench compare: REGRESSION" : "pathbench compare: no regression");
+  }
   return any ? 1 : 0;
 }
 

@@ -9,6 +9,7 @@
 #include "cli_checks.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
 
@@ -218,8 +219,10 @@ int run_reproduce(const ReproduceOptions& o) {
                       "(--budget); their time at {} spp is the measured time x {} / spp run (render time is linear "
                       "in spp).\n",
                       o.spp, o.spp);
-  md += fmt::format("- CPU: {} ({} hardware threads). Git revision {}. Whole run: {:.1f} s wall.\n", cpu_model(),
-                    hardware_threads(), git_revision(), wall);
+  md += fmt::format("- CPU: {} ({} hardware threads; machine_id {}, the fingerprint is in the report JSON). Git "
+                    "revision {}. Whole run: {:.1f} s wall.\n",
+                    cpu_model(), hardware_threads(), machine_fingerprint()["machine_id"].get<std::string>(),
+                    git_revision(), wall);
   if (!have_gpu) md += fmt::format("- GPU rows absent: {}.\n", why_no_gpu);
   write_text_file(dir + "/paper-cornell.md", md);
   fmt::print("\n{}\nwritten: {}/paper-cornell.md, paper-cornell-report.json, images\n", md, dir);

@@ -1,22 +1,20 @@
 #include "bench_context.h"
 
 #include <benchmark/benchmark.h>
-#include <embree3/rtcore_config.h>
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <tbb/task_arena.h>
 
-#include <chrono>
-#include <cstdlib>
 #include <ctime>
 #include <fstream>
+#include <iterator>
+#include <stdexcept>
 
+#include "compare_command.h"
+#include "device_render.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/report.h"
 #include "pathbench/cpu/isa.h"
-
-#if PATHBENCH_BENCH_GPU
-#include "pathbench/gpu/render.h"
-#endif
 
 namespace pb::bench {
 
@@ -38,50 +36,67 @@ std::string utc_now() {
 
 void add(const char* key, const std::string& value) { benchmark::AddCustomContext(key, value); }
 
-void add_gpu_context() {
-#if PATHBENCH_BENCH_GPU
-  std::string why;
-  if (!gpu::device_available(&why)) {
-    add("gpu", "none: " + why);
-    return;
-  }
-  const gpu::DeviceInfo info = gpu::device_info();
-  add("gpu_name", info.name);
-  add("gpu_compute_capability", fmt::format("{}.{}", info.compute_major, info.compute_minor));
-  add("gpu_multiprocessors", std::to_string(info.multiprocessors));
-  add("gpu_memory_bytes", std::to_string(info.total_memory));
-  add("cuda_driver_api", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10));
-  add("cuda_runtime", fmt::format("{}.{}", info.runtime_version / 1000, (info.runtime_version % 1000) / 10));
-  const std::string nv = first_line("/proc/driver/nvidia/version");  // the kernel driver's own version line
-  add("gpu_driver", nv.empty() ? "unknown" : nv);
-#else
-  add("gpu", "none (built without the CUDA tracer)");
-#endif
+// Fingerprint with the GPU's section where this build has the GPU tracer.
+const nlohmann::json& fingerprint() {
+  static const nlohmann::json fp = app::run_fingerprint(PATHBENCH_BENCH_GPU != 0);
+  return fp;
+}
+
+nlohmann::json& run_start() {
+  static nlohmann::json start;
+  return start;
 }
 
 }  // namespace
 
 void add_environment_context(const std::string& preset) {
+  run_start() = app::load_sample();
+  const nlohmann::json& fp = fingerprint();
+  const nlohmann::json& build = fp["build"];
   add("pathbench_preset", preset);
   add("cpu_model", cpu_model());
   add("cpu_hardware_threads", std::to_string(hardware_threads()));
   add("cpu_tbb_threads", std::to_string(tbb::this_task_arena::max_concurrency()));
-  add("machine", machine_slug());
-  add("compiler", fmt::format("{} ({})", PATHBENCH_BENCH_COMPILER, compiler_id()));
-  add("cxx_flags", PATHBENCH_BENCH_CXX_FLAGS);
-  add("build_type", PATHBENCH_BENCH_BUILD_TYPE);
-  add("embree_version", RTC_VERSION_STRING);
+  add("machine", machine_slug());  // results/<machine>/ folder; the identity is machine_id
+  // As before the fingerprint ("GNU 12.2.0 (gcc 12.2.0)"), so old and new files agree.
+  add("compiler", fmt::format("{} ({})", build["cmake_compiler"].get<std::string>(), build["compiler"].get<std::string>()));
+  add("cxx_flags", build["cxx_flags"].get<std::string>());
+  add("build_type", build["build_type"].get<std::string>());
+  add("embree_version", fp["libraries"]["embree"].get<std::string>());
+  std::string rev = build["git_revision"].get<std::string>();
+  if ((rev.empty() || rev == "unknown") && build.contains("source_commit"))
+    rev = build["source_commit"].get<std::string>() + " (PATHBENCH_SOURCE_COMMIT; the tree may have had uncommitted changes)";
   add("cpu_vector_flags", fmt::format("{}", fmt::join(cpu::cpu_vector_flags(), " ")));  // which --isa can run
-  // A copy of the tree without .git (a GPU host) has no revision of its own; the
-  // copier may name the source commit in PATHBENCH_SOURCE_COMMIT.
-  std::string rev = git_revision();
-  const char* source_commit = std::getenv("PATHBENCH_SOURCE_COMMIT");
-  if ((rev.empty() || rev == "unknown") && source_commit && *source_commit)
-    rev = std::string(source_commit) + " (PATHBENCH_SOURCE_COMMIT; the tree may have had uncommitted changes)";
   add("git_revision", rev.empty() ? "unknown" : rev);
   add("date_utc", utc_now());
   add("load_average_at_start", first_line("/proc/loadavg"));
-  add_gpu_context();
+  if (fp.contains("gpu") && fp["gpu"].contains("name")) {
+    add("gpu_name", fp["gpu"]["name"].get<std::string>());
+    add("gpu_driver", fp["gpu"]["driver"].get<std::string>());
+    add("cuda_runtime", fp["gpu"]["cuda_runtime"].get<std::string>());
+  } else {
+    add("gpu", fp.contains("gpu") ? "none: " + fp["gpu"].value("none", std::string("?"))
+                                  : std::string("none (built without the CUDA tracer)"));
+  }
+}
+
+void finish_benchmark_json(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the benchmark output back", path));
+  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  // Google Benchmark writes NaN for the cv of a counter that is always zero (0 / 0);
+  // the tolerant parser reads it as null. Duplicate keys collapse on parsing (and no
+  // counter of ours is named like one of Google Benchmark's keys).
+  nlohmann::ordered_json doc = app::parse_benchmark_json_text(raw, path);
+  const nlohmann::json end = app::load_sample();
+  auto& ctx = doc["context"];
+  ctx["machine_id"] = fingerprint()["machine_id"];
+  ctx["fingerprint"] = nlohmann::ordered_json::parse(fingerprint().dump());
+  ctx["load_average_at_end"] = first_line("/proc/loadavg");
+  if (!run_start().is_null())
+    ctx["run"] = nlohmann::ordered_json::parse(app::load_between(run_start(), end).dump());
+  app::write_text_file(path, doc.dump(2) + "\n");
 }
 
 }  // namespace pb::bench

@@ -12,7 +12,9 @@
 //   materials  diffuse-only against mirror/glass/GGX scenes (materials_bench.h).
 //
 // Regression runs: --benchmark_repetitions=9 --benchmark_report_aggregates_only=false
-// --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`.
+// --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`. That file is
+// strict JSON with the machine fingerprint (bench_context.h); JSON on stdout
+// (--benchmark_format=json) is Google Benchmark's own, NaN included.
 #include <benchmark/benchmark.h>
 #include <fmt/core.h>
 
@@ -135,6 +137,15 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling or materials)\n", preset);
     return 2;
   }
+  // The output file (--benchmark_out=PATH, JSON unless another format is asked for) is
+  // rewritten after the run as strict JSON with the fingerprint and the end-of-run load.
+  // Read before Initialize, which removes the flags it knows from argv.
+  std::string out_path, out_format = "json";
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string a = args[i];
+    if (a.rfind("--benchmark_out=", 0) == 0) out_path = a.substr(16);
+    if (a.rfind("--benchmark_out_format=", 0) == 0) out_format = a.substr(23);
+  }
   int new_argc = int(args.size());
   args.push_back(nullptr);
   benchmark::Initialize(&new_argc, args.data());
@@ -142,5 +153,13 @@ int main(int argc, char** argv) {
   pb::bench::add_environment_context(preset);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  if (!out_path.empty() && out_format == "json") {
+    try {
+      pb::bench::finish_benchmark_json(out_path);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
+      return 1;
+    }
+  }
   return 0;
 }

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/path.h"
 #include "pathbench/common/settings.h"
 #include "pathbench/cpu/embree_scene.h"  // the tracer's own Embree scene
@@ -192,18 +193,24 @@ void run_raycast(benchmark::State& state, const RaycastCase& c, Api api, bool co
     state.SkipWithError("no rays: every camera ray missed the scene");
     return;
   }
+  using benchmark::Counter;
   const RTCScene handle = prep->embree->handle();
   uint64_t hits = 0;
+  const double cpu0 = process_cpu_seconds();
   for (auto _ : state) {
     hits = cast_all(handle, api, rays, coherent);
     benchmark::DoNotOptimize(hits);
   }
-  using benchmark::Counter;
+  // Process CPU time (every thread), per iteration: beside the wall time it tells a
+  // contended run (wall up, CPU flat) from a slower one (both up). Google Benchmark's
+  // cpu_time is the main thread's only.
+  state.counters["process_cpu_seconds"] = Counter(process_cpu_seconds() - cpu0, Counter::kAvgIterations);
   state.counters["rays_per_second"] = Counter(double(rays.size()), Counter::kIsIterationInvariantRate);
   state.counters["rays"] = double(rays.size());
   state.counters["hit_fraction"] = double(hits) / double(rays.size());
   state.counters["triangles"] = double(cached_scene(c.scene)->triangles.size());
-  state.counters["threads"] = double(tbb::this_task_arena::max_concurrency());
+  // Not "threads": Google Benchmark writes its own "threads" key in every row.
+  state.counters["cpu_threads"] = double(tbb::this_task_arena::max_concurrency());
   state.SetLabel(std::string("embree_layout=") + to_string(prep->embree->layout()));  // as render benchmarks
 }
 

@@ -51,6 +51,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   uint64_t rays = 0, paths = 0;
   RunReport last;
   uint64_t peak_host = 0, peak_device = 0, tracer_host = 0;
+  double cpu_seconds = 0;
   for (auto _ : state) {
     reset_peak_rss();
     RunReport r;
@@ -66,6 +67,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
     peak_host = std::max(peak_host, r.peak_host_bytes);
     peak_device = std::max(peak_device, r.peak_device_bytes);
     tracer_host = std::max(tracer_host, r.tracer_host_bytes);
+    cpu_seconds += r.load.value("process_cpu_seconds", 0.0);
     last = r;
   }
   using benchmark::Counter;
@@ -79,7 +81,11 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   state.counters["paths_in_flight"] = double(last.paths_in_flight);
   state.counters["pixels_x_spp"] = double(s.total_samples());
   state.counters["triangles"] = double(scene->triangles.size());
-  state.counters["threads"] = double(last.threads);
+  // Not "threads": Google Benchmark writes its own "threads" key in every row.
+  state.counters["cpu_threads"] = double(last.threads);
+  // Process CPU time (every thread) per iteration, around the whole render call: beside
+  // the wall time it tells a contended run (wall up, CPU flat) from a slower one.
+  state.counters["process_cpu_seconds"] = Counter(cpu_seconds, Counter::kAvgIterations);
   // Which Embree layout the CPU traced (auto decides per scene and process) and which
   // instruction set its path step ran (--isa auto: the widest the CPU has): a change of
   // either between two runs shows here, not only as a change of speed.

@@ -34,7 +34,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import cpu_model, machine_slug  # noqa: E402
+from machine import cpu_model, host_fingerprint, machine_slug  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 MAX_SLOWDOWN = 0.03
@@ -147,7 +147,7 @@ def main(argv=None):
     if not a.off_build:
         build(off, False, a.jobs)
 
-    res = {"method": a.method, "machine": cpu_model(), "git_revision": git_revision(),
+    res = {"method": a.method, "machine": cpu_model(), "fingerprint": host_fingerprint(), "git_revision": git_revision(),
            "load_average_before": [round(x, 2) for x in os.getloadavg()], "max_slowdown": MAX_SLOWDOWN,
            "builds": {"normal": str(on), "diffuse_only": str(off)}, "strategies": {}}
     for strategy in STRATEGIES:

@@ -28,6 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mitsuba_scene as ms  # noqa: E402
+from machine import slugify  # noqa: E402
 from machine import cpu_model  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -60,7 +61,7 @@ def main(argv=None):
     scene = ms.load_scene(mi, width=a.size, height=a.size, spp=a.spp, max_depth=max_depth, scene=a.scene)
     cache = Path(a.cache)
     cache.mkdir(parents=True, exist_ok=True)
-    slug = a.scene.replace(":", "-")
+    slug = slugify(a.scene, "scene")  # "cornell-box:ggx" -> "cornell-box-ggx", as pb::slugify
     tag = f"{a.variant}-{a.size}-{a.spp}spp"
     if a.scene != "paper-cornell" or max_depth != ms.MAX_DEPTH:
         tag = f"{slug}-depth{max_depth}-{tag}"

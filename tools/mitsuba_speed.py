@@ -45,7 +45,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mitsuba_scene as ms  # noqa: E402
 import raw_embree_mix  # noqa: E402
-from machine import cpu_model, cpu_vector_flags, machine_slug  # noqa: E402
+from machine import cpu_model, cpu_vector_flags, host_fingerprint, machine_slug  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -268,6 +268,7 @@ def main(argv=None):
         "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "machine": {"slug": machine_slug(), "cpu": cpu_model(), "hardware_threads": os.cpu_count(),
                     "cpu_flags": cpu_vector_flags()},
+        "fingerprint": host_fingerprint(),
         "settings": {"scene": "paper-cornell", "width": a.size, "height": a.size, "spp": a.spp, "bounces": 2,
                      "sampling": "nee", "filter": "box", "repeats": a.repeats},
         "load_average_before": loadavg(),

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import cpu_model, machine_slug  # noqa: E402
+from machine import cpu_model, host_fingerprint, machine_slug  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER_TASK_BYTES = 48
@@ -56,7 +56,7 @@ def main(argv=None):
     wf = {(x["size"], x["spp"]): x for x in rows if x["strategy"] == "wavefront"}
     small, big = wf[CONFIGS[0]], wf[CONFIGS[1]]
     ratio = big["peak_host_bytes"] / small["peak_host_bytes"]
-    res = {"machine": {"slug": machine_slug(), "cpu": cpu_model()}, "rows": rows,
+    res = {"machine": {"slug": machine_slug(), "cpu": cpu_model()}, "fingerprint": host_fingerprint(), "rows": rows,
            "wavefront_peak_ratio_512x300_over_256x800": round(ratio, 4)}
     out = Path(a.out_dir) if a.out_dir else ROOT / "results" / machine_slug()
     out.mkdir(parents=True, exist_ok=True)

@@ -4,16 +4,15 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
-#ifndef PATHBENCH_GIT_REVISION
-#define PATHBENCH_GIT_REVISION "unknown"
-#endif
+#include "pathbench/common/fingerprint.h"
 
 namespace pb {
+
+extern const char* const kGitRevision;  // generated at build time (cmake/git_revision.cmake)
 
 nlohmann::json RunReport::to_json() const {
   nlohmann::json j;
@@ -45,6 +44,8 @@ nlohmann::json RunReport::to_json() const {
   j["machine"] = {{"cpu", cpu_model()}, {"hardware_threads", hardware_threads()}, {"threads", threads}};
   j["git_revision"] = git_revision();
   j["compiler"] = compiler_id();
+  j["fingerprint"] = fingerprint.is_null() ? machine_fingerprint() : fingerprint;
+  if (!load.is_null()) j["load"] = load;
   for (auto& [k, v] : extra.items()) j[k] = v;
   return j;
 }
@@ -67,7 +68,7 @@ std::string cpu_model() {
 
 int hardware_threads() { return int(std::max(1u, std::thread::hardware_concurrency())); }
 
-std::string git_revision() { return PATHBENCH_GIT_REVISION; }
+std::string git_revision() { return kGitRevision; }
 
 std::string compiler_id() {
 #if defined(__clang__)
@@ -94,19 +95,13 @@ uint64_t peak_resident_bytes() {
 }
 
 std::string machine_slug() {
-  std::string m = cpu_model();
-  // "AMD EPYC 7B13 64-Core Processor" -> "amd-epyc-7b13-64-core-processor"
-  std::string out;
-  for (char c : m) {
-    if (std::isalnum(static_cast<unsigned char>(c))) out += char(std::tolower(static_cast<unsigned char>(c)));
-    else if (!out.empty() && out.back() != '-') out += '-';
-  }
-  while (!out.empty() && out.back() == '-') out.pop_back();
-  for (const char* noise : {"-processor", "-cpu"}) {
-    auto pos = out.find(noise);
-    if (pos != std::string::npos && pos + std::string(noise).size() == out.size()) out.erase(pos);
-  }
-  return out.empty() ? "unknown-machine" : out;
+  // "AMD EPYC 7B13 64-Core Processor" -> "amd-epyc-7b13-64-core": folder names only;
+  // a machine is identified by its fingerprint's machine_id.
+  std::string out = slugify(cpu_model(), "unknown-machine");
+  for (std::string noise : {"-processor", "-cpu"})
+    if (out.size() > noise.size() && out.compare(out.size() - noise.size(), noise.size(), noise) == 0)
+      out.erase(out.size() - noise.size());
+  return out;
 }
 
 }  // namespace pb

@@ -15,6 +15,7 @@
 #include "cuda_util.h"
 #include "kernel_sync.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/fingerprint.h"
 #include "pathbench/common/path.h"
 #include "pathbench/gpu/bvh.h"
 #include "pathbench/gpu/bvh_build.h"
@@ -473,16 +474,6 @@ std::string kernel_driver_version() {
   return v;
 }
 
-std::string slugify(const std::string& name) {
-  std::string out;
-  for (char ch : name) {
-    if (std::isalnum(static_cast<unsigned char>(ch))) out += char(std::tolower(static_cast<unsigned char>(ch)));
-    else if (!out.empty() && out.back() != '-') out += '-';
-  }
-  while (!out.empty() && out.back() == '-') out.pop_back();
-  return out.empty() ? "unknown-gpu" : out;
-}
-
 void ensure_device() {
   std::string why;
   if (!device_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
@@ -543,7 +534,7 @@ DeviceInfo device_info() {
   info.total_memory = prop.totalGlobalMem;
   PB_CUDA_CHECK(cudaDriverGetVersion(&info.driver_version));
   PB_CUDA_CHECK(cudaRuntimeGetVersion(&info.runtime_version));
-  info.slug = slugify(info.name);
+  info.slug = pb::slugify(info.name, "unknown-gpu");
   return info;
 }
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """CI smoke check of pathbench-bench: runs `--preset quick` (short min time) into a
-JSON file and asserts that the CPU pixel and wavefront render rows carry every
-counter, that ray-cast rows carry rays_per_second, and that the context names the
-environment. Never asserts a speed. Standard library only.
+JSON file and asserts that it is strict JSON (no NaN/Infinity, no duplicate keys),
+that the CPU pixel and wavefront render rows carry every counter, that ray-cast rows
+carry rays_per_second, and that the context names the environment and carries the
+machine fingerprint. Never asserts a speed. Standard library only.
 
   check_bench_json.py --bench build/bin/pathbench-bench --out /tmp/quick.json
   check_bench_json.py --json existing.json      (check a file without running)
@@ -14,7 +15,31 @@ import sys
 
 RENDER_COUNTERS = ["rays_per_second", "paths_per_second", "peak_host_bytes", "peak_device_bytes",
                    "state_bytes_per_path", "queue_bytes"]
-CONTEXT_KEYS = ["cpu_model", "cpu_hardware_threads", "compiler", "cxx_flags", "git_revision", "date_utc"]
+CONTEXT_KEYS = ["cpu_model", "cpu_hardware_threads", "compiler", "cxx_flags", "git_revision", "date_utc",
+                "machine_id", "fingerprint", "load_average_at_start", "load_average_at_end", "run"]
+FINGERPRINT_KEYS = ["machine_id", "cpu", "memory_bytes", "clock", "os", "build", "libraries", "embree"]
+
+
+class StrictJSONError(ValueError):
+    pass
+
+
+def _no_duplicates(pairs):
+    seen = {}
+    for k, v in pairs:
+        if k in seen:
+            raise StrictJSONError(f"duplicate key {k!r}")
+        seen[k] = v
+    return seen
+
+
+def _no_constant(c):
+    raise StrictJSONError(f"non-standard constant {c}")
+
+
+def strict_loads(text):
+    """json.loads that refuses NaN/Infinity and duplicate keys (what strict parsers do)."""
+    return json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_no_constant)
 
 
 def check(doc):
@@ -23,6 +48,12 @@ def check(doc):
     for k in CONTEXT_KEYS:
         if k not in ctx:
             errors.append(f"context lacks '{k}'")
+    fp = ctx.get("fingerprint", {})
+    for k in FINGERPRINT_KEYS:
+        if not isinstance(fp, dict) or k not in fp:
+            errors.append(f"context.fingerprint lacks '{k}'")
+    if isinstance(fp, dict) and fp.get("machine_id") != ctx.get("machine_id"):
+        errors.append("context.machine_id is not the fingerprint's")
     runs = [b for b in doc.get("benchmarks", []) if b.get("run_type", "iteration") == "iteration"]
     for strategy in ("pixel", "wavefront"):
         rows = [b for b in runs if b["name"].startswith(f"render/cpu/{strategy}/")]
@@ -69,7 +100,12 @@ def main():
             return 1
         path = a.out
     with open(path) as f:
-        doc = json.load(f)
+        text = f.read()
+    try:
+        doc = strict_loads(text)
+    except (StrictJSONError, ValueError) as e:
+        print(f"FAIL: {path} is not strict JSON: {e}", file=sys.stderr)
+        return 1
     errors = check(doc)
     for e in errors:
         print("FAIL:", e, file=sys.stderr)

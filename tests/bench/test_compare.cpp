@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <sys/wait.h>
 
@@ -39,6 +40,27 @@ std::string scaled_copy(const std::string& in, double f, const std::string& name
   const std::string out = std::string(PATHBENCH_TEST_TMP) + "/" + name;
   std::ofstream(out) << j.dump(1);
   return out;
+}
+
+// A copy of `in` with the wall time of every iteration scaled by `f` and its CPU time
+// left as it was: what another process taking the cores does.
+std::string wall_only_copy(const std::string& in, double f, const std::string& name) {
+  nlohmann::json j = pb::app::read_benchmark_json(in);
+  for (auto& b : j["benchmarks"])
+    if (b.contains("real_time")) b["real_time"] = b["real_time"].get<double>() * f;
+  const std::string out = std::string(PATHBENCH_TEST_TMP) + "/" + name;
+  std::ofstream(out) << j.dump(1);
+  return out;
+}
+
+// Runs the command line; returns its exit status and (in *out) its stdout.
+int cli_out(const std::string& args, std::string* out) {
+  const std::string file = std::string(PATHBENCH_TEST_TMP) + "/cli-out.txt";
+  const std::string cmd = std::string(PATHBENCH_CLI) + " compare " + args + " > " + file + " 2>/dev/null";
+  const int st = std::system(cmd.c_str());
+  std::ifstream in(file);
+  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
 int cli(const std::string& args) {
@@ -135,6 +157,82 @@ TEST(CompareCli, ExitStatuses) {
   EXPECT_EQ(cli(kData + "base.json " + kData + "not-benchmark.json"), 2);
   EXPECT_EQ(cli(kData + "base.json " + kData + "too-few-repetitions.json"), 2);
   EXPECT_EQ(cli(kData + "base.json"), 2);  // NEW missing
+}
+
+TEST(CompareContext, NoCommonNameIsRefused) {
+  EXPECT_THROW(compare(kData + "base.json", kData + "other-names.json"), pb::InputError);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "other-names.json"), 2);
+}
+
+TEST(CompareContext, ZeroTimesAreNotAnImprovement) {
+  auto rows = pb::app::compare_files(pb::app::load_benchmark_json(kData + "base.json", 9),
+                                     pb::app::load_benchmark_json(kData + "zero-times.json", 9), 0.05, 0.05);
+  for (const auto& r : rows) EXPECT_EQ(r.verdict, pb::app::Verdict::Invalid) << r.name;
+  EXPECT_EQ(cli(kData + "base.json " + kData + "zero-times.json"), 2);  // nothing left to compare
+  EXPECT_EQ(cli(kData + "zero-times.json " + kData + "base.json"), 2);
+}
+
+TEST(CompareContext, OtherMachineWarnsAndStrictRefuses) {
+  std::string out;
+  EXPECT_EQ(cli_out(kData + "base.json " + kData + "other-machine.json", &out), 0);
+  EXPECT_NE(out.find("WARNING: different machine"), std::string::npos) << out;
+  EXPECT_NE(out.find("mhz_per_cpu: 2445 -> 2596"), std::string::npos) << out;
+  EXPECT_EQ(cli(kData + "base.json " + kData + "other-machine.json --strict"), 2);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "identical.json --strict"), 0);
+}
+
+TEST(CompareContext, OtherLayoutWarnsAndStrictRefuses) {
+  std::string out;
+  EXPECT_EQ(cli_out(kData + "base.json " + kData + "layout-triangles.json --format json", &out), 0);
+  const auto j = nlohmann::json::parse(out);
+  ASSERT_EQ(j["warnings"].size(), 1u) << out;
+  EXPECT_NE(j["warnings"][0].get<std::string>().find("different Embree layout in 3 benchmark(s)"), std::string::npos);
+  EXPECT_EQ(cli(kData + "base.json " + kData + "layout-triangles.json --strict"), 2);
+}
+
+// Two real runs of the same binary (tests/data/bench/README.md): the second with eight
+// busy loops beside it. Wall time went up 12-17 fold, CPU time by a sixth to a third:
+// contended, not a regression; --strict refuses the pair.
+TEST(CompareContext, RealContendedRunIsFlaggedContended) {
+  auto rows = pb::app::compare_files(pb::app::load_benchmark_json(kData + "quick-quiet.json", 9),
+                                     pb::app::load_benchmark_json(kData + "quick-contended.json", 9), 0.05, 0.05);
+  ASSERT_FALSE(rows.empty());
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.verdict, pb::app::Verdict::Contended) << r.name;
+    EXPECT_TRUE(r.has_cpu && r.diverges) << r.name;
+  }
+  std::string out;
+  EXPECT_EQ(cli_out(kData + "quick-quiet.json " + kData + "quick-contended.json", &out), 0);
+  EXPECT_NE(out.find("contended"), std::string::npos) << out;
+  EXPECT_EQ(cli(kData + "quick-quiet.json " + kData + "quick-contended.json --strict"), 2);
+}
+
+TEST(CompareContext, WallUpCpuFlatIsContendedBothUpIsRegression) {
+  const std::string real = kData + "quick-9rep.json";
+  auto base = pb::app::load_benchmark_json(real, 9);
+  auto wall = pb::app::load_benchmark_json(wall_only_copy(real, 1.3, "quick-wall-1.3.json"), 9);
+  auto both = pb::app::load_benchmark_json(scaled_copy(real, 1.3, "quick-both-1.3.json"), 9);
+  // (One real series, occluded1/coherent, is too spread for p < 0.05 at +30%: "same".)
+  const auto by_wall = pb::app::compare_files(base, wall, 0.05, 0.05);
+  const auto by_both = pb::app::compare_files(base, both, 0.05, 0.05);
+  for (const auto& r : by_wall) EXPECT_NE(r.verdict, pb::app::Verdict::Regressed) << r.name;
+  for (const auto& r : by_both) EXPECT_NE(r.verdict, pb::app::Verdict::Contended) << r.name;
+  EXPECT_GE(pb::app::count_verdict(by_wall, pb::app::Verdict::Contended), int(by_wall.size()) - 1);
+  EXPECT_GE(pb::app::count_verdict(by_both, pb::app::Verdict::Regressed), int(by_both.size()) - 1);
+}
+
+TEST(CompareCli, Formats) {
+  std::string out;
+  EXPECT_EQ(cli_out(kData + "base.json " + kData + "slower10.json --format json", &out), 1);
+  const auto j = nlohmann::json::parse(out);
+  EXPECT_EQ(j["verdict"], "regression");
+  EXPECT_EQ(j["regressed"], 3);
+  EXPECT_NEAR(j["benchmarks"][0]["time_change"].get<double>(), 0.10, 1e-9);
+  EXPECT_NEAR(j["benchmarks"][0]["cpu_change"].get<double>(), 0.10, 1e-9);
+  EXPECT_EQ(cli_out(kData + "base.json " + kData + "slower10.json --format markdown", &out), 1);
+  EXPECT_NE(out.find("| benchmark | base median |"), std::string::npos) << out;
+  EXPECT_NE(out.find("**REGRESSED**"), std::string::npos) << out;
+  EXPECT_EQ(cli(kData + "base.json " + kData + "slower10.json --format yaml"), 2);
 }
 
 }  // namespace

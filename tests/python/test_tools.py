@@ -130,3 +130,27 @@ def test_raw_shares_per_isa():
     out = raw_embree_mix.shares(reports, rates)
     assert [(s["isa"], s["share"]) for s in out] == [("avx512", round(20.0 / (400 / 15), 4)),
                                                       ("avx2", round(10.0 / (400 / 15), 4))]
+
+
+def test_machine_id_agrees_with_the_render_report(tmp_path):
+    """tools/machine.py and pathbench's C++ fingerprint name this machine alike (fixture
+    machines: tests/bench/test_fingerprint.cpp)."""
+    import json
+    import subprocess
+    from pathlib import Path
+    exe = Path(__file__).resolve().parents[2] / "build" / "bin" / "pathbench"
+    if not exe.exists():
+        pytest.skip("build/bin/pathbench not built")
+    report = tmp_path / "r.json"
+    subprocess.run([str(exe), "render", "--scene", "paper-cornell", "--width", "8", "--height", "8", "--spp", "1",
+                    "--quiet", "--report", str(report)], check=True)
+    fp = json.loads(report.read_text())["fingerprint"]
+    host = machine.host_fingerprint()
+    assert fp["machine_id"] == host["machine_id"]
+    assert fp["cpu"] == host["cpu"]
+
+
+def test_slugify_is_the_cpp_rule():
+    assert machine.slugify("cornell-box:mirror", "x") == "cornell-box-mirror"
+    assert machine.slugify("caf\u00e9 GPU", "x") == "caf-gpu"
+    assert machine.slugify(" -- ", "scene") == "scene"

@@ -34,6 +34,12 @@ struct RunReport {
   uint64_t paths_in_flight = 0;
   int threads = 0;
   nlohmann::json extra = nlohmann::json::object();  // device-specific: GPU name, profile, ...
+  // The machine fingerprint (pathbench/common/fingerprint.h) with the tracer's own
+  // sections; null: to_json writes the host's machine_fingerprint().
+  nlohmann::json fingerprint;
+  // Contention evidence: load average and process CPU time against wall time around
+  // the render (pb::app::render_on_device fills it); null when not measured.
+  nlohmann::json load;
 
   double rays_per_second() const { return seconds > 0 ? double(rays.total()) / seconds : 0; }
   nlohmann::json to_json() const;
@@ -45,6 +51,6 @@ int hardware_threads();
 std::string git_revision();
 std::string compiler_id();
 uint64_t peak_resident_bytes();   // VmHWM of this process
-std::string machine_slug();       // results/<machine>/ folder name from the CPU model
+std::string machine_slug();       // results/<machine>/ folder name: pb::slugify of the CPU model
 
 }  // namespace pb

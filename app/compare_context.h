@@ -1,0 +1,14 @@
+#pragma once
+// What `pathbench compare` checks before trusting a comparison: whether the two runs
+// ran on the same machine (fingerprint machine_id and identity fields, or Google
+// Benchmark's CPU facts for files without a fingerprint), the same build (compiler,
+// flags, libraries), the same settings (preset, threads), the same Embree layout per
+// benchmark (labels "embree_layout=..."), and under similar load.
+#include "compare_command.h"
+
+namespace pb::app {
+
+// Fills rep.base_run / new_run, rep.warnings and rep.notes.
+void describe_runs(const BenchFile& base, const BenchFile& next, CompareReport& rep);
+
+}  // namespace pb::app
