@@ -72,7 +72,7 @@ int64_t int_arg(const py::handle& v, const char* name, int64_t lo, int64_t hi) {
   int overflow = 0;
   const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
   if (overflow || x < lo || x > hi)
-    throw py::value_error(fmt::format("{} = {} is out of range [{}, {}]", name, std::string(py::str(i)), lo, hi));
+    throw py::value_error(fmt::format("{} = {} is out of range [{}, {}]", name, std::string(py::repr(i)), lo, hi));
   return x;
 }
 
@@ -83,7 +83,7 @@ uint64_t uint64_arg(const py::handle& v, const char* name) {
   const unsigned long long x = PyLong_AsUnsignedLongLong(i.ptr());  // refuses negatives and > 2^64 - 1
   if (PyErr_Occurred()) {
     PyErr_Clear();
-    throw py::value_error(fmt::format("{} = {} is out of range [0, {}]", name, std::string(py::str(i)), UINT64_MAX));
+    throw py::value_error(fmt::format("{} = {} is out of range [0, {}]", name, std::string(py::repr(i)), UINT64_MAX));
   }
   return x;
 }

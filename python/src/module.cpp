@@ -106,7 +106,7 @@ std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::arr
 }  // namespace
 }  // namespace pb::py_bind
 
-PYBIND11_MODULE(pathbench, m) {
+PYBIND11_MODULE(_core, m) {
   using namespace pb::py_bind;
   using pb::python::SceneHandle;
   m.doc() = "pathbench: scenes as numpy arrays, batched ray casts (Embree or the GPU BVH on the host), renders";
