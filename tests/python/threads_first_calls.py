@@ -4,7 +4,7 @@ initialisation inside the module (numpy's C API table, pybind11's internals, Emb
 device, TBB's arena, the scene caches) is raced. Prints "ok" and exits 0 when every
 thread finished; a deadlock shows as a timeout in the caller.
 
-usage: python threads_first_calls.py [THREADS]
+usage: python threads_first_calls.py [THREADS] [DEVICE]   (DEVICE: cpu, the default, or gpu)
 """
 import sys
 import threading
@@ -16,6 +16,7 @@ import pathbench
 
 def main() -> int:
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 8
+    device = sys.argv[2] if len(sys.argv) > 2 else "cpu"
     barrier = threading.Barrier(n)
     errors = []
 
@@ -27,7 +28,7 @@ def main() -> int:
             d = np.eye(4, 3) + np.float64(k + 1)
             scene.intersect(o, d, backend="embree" if k % 2 else "bvh")
             scene.occluded(o, d)
-            image, report = pathbench.render(scene, 8, 8, 1, seed=k, threads=1 + k % 2)
+            image, report = pathbench.render(scene, 8, 8, 1, seed=k, threads=1 + k % 2, device=device)
             assert image.shape == (8, 8, 3) and report["spp"] == 1
         except BaseException as e:  # noqa: BLE001 - reported to the caller below
             errors.append(f"thread {k}: {type(e).__name__}: {e}")
