@@ -59,7 +59,8 @@ void initialise_at_import() {
 }
 
 py::dict intersect(const SceneHandle& s, const py::handle& origins, const py::handle& directions,
-                   const py::handle& tnear, const py::handle& tfar, const py::handle& backend_name, const py::handle& watertight_flag) {
+                   const py::handle& tnear, const py::handle& tfar, const py::handle& backend_name,
+                   const py::handle& watertight_flag) {
   const Batch b = make_batch(origins, directions, tnear, tfar);
   const auto be = pb::python::parse_backend(pb::python::str_arg(backend_name, "backend"));
   const bool watertight = pb::python::bool_arg(watertight_flag, "watertight");
