@@ -21,23 +21,23 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--height", o.settings.height, "image height in pixels")->check(non_negative())->capture_default_str();
   cmd.add_option("--spp", o.settings.spp, "samples per pixel")->check(non_negative())->capture_default_str();
   auto* b = cmd.add_option("--bounces", o.settings.max_bounces, "diffuse bounces (the paper: 2)")->capture_default_str();
-  cmd.add_flag("--converged", o.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
+  cmd.add_flag("--converged", o.choices.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
   cmd.add_flag("--rr,!--no-rr", o.settings.russian_roulette, "Russian roulette (default: only with --converged)");
   cmd.add_flag("--watertight,!--no-watertight", o.settings.watertight,
                "watertight ray/triangle test (default on; off is faster on the CPU and can leak at edges)");
-  cmd.add_option("--precision", o.precision,
+  cmd.add_option("--precision", o.choices.precision,
                  "scalar type of the path step: float or double (the hit triangle is found in float either way)")
       ->capture_default_str();
-  cmd.add_option("--embree-layout", o.embree_layout,
+  cmd.add_option("--embree-layout", o.choices.embree_layout,
                  "CPU: triangles to Embree as they are, paired into quads, or auto (measured per scene)")
       ->capture_default_str();
-  cmd.add_option("--isa", o.isa,
+  cmd.add_option("--isa", o.choices.isa,
                  "CPU: instruction set of the batched path step: auto (widest the CPU has), avx512, avx2 or scalar; "
                  "same image with each")
       ->capture_default_str();
-  cmd.add_option("--sampling", o.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
-  cmd.add_option("--device", o.device, "cpu or gpu")->capture_default_str();
-  cmd.add_option("--strategy", o.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
+  cmd.add_option("--sampling", o.choices.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
+  cmd.add_option("--device", o.choices.device, "cpu or gpu")->capture_default_str();
+  cmd.add_option("--strategy", o.choices.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
   cmd.add_option("--paths-in-flight", o.settings.paths_in_flight,
                  "wavefront pool size (0: device default; at most the frame's samples)")
       ->check(non_negative());
@@ -51,19 +51,9 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
 }
 
 void finish_render_options(RenderOptions& o) {
-  o.settings.sampling = parse_sampling(o.sampling);
-  o.settings.strategy = parse_strategy(o.strategy);
-  o.settings.device = parse_device(o.device);
-  o.settings.precision = parse_precision(o.precision);
-  o.settings.embree_layout = parse_embree_layout(o.embree_layout);
-  o.settings.isa = parse_isa(o.isa);
-  if (o.converged) {
-    o.settings.max_bounces = -1;
-    o.settings.russian_roulette = true;
-  }
   o.settings.variance = !o.variance_out.empty();
   o.settings.progress = !o.quiet;
-  o.settings.validate();
+  apply_choices(o.choices, o.settings);
   for (const std::string* path : {&o.out, &o.variance_out}) {
     if (path->empty()) continue;
     const std::string ext = image_extension(*path);

@@ -15,10 +15,7 @@ namespace pb::app {
 struct RenderOptions {
   std::string scene = "paper-cornell";
   RenderSettings settings;
-  std::string sampling = "nee", strategy = "pixel", device = "cpu", precision = "float";
-  std::string embree_layout = "auto";
-  std::string isa = "auto";
-  bool converged = false;
+  RenderChoices choices;  // the named options, applied by apply_choices (common/settings.h)
   std::string out, report, variance_out;
   bool profile = false;
   bool quiet = false;

@@ -10,7 +10,7 @@ apt_pkgs=(build-essential cmake ninja-build ccache pkg-config git python3 python
           libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
           librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
           libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev
-          python3-dev pybind11-dev  # the `pathbench` Python module (python/)
+          python3-dev  # the `pathbench` Python module (python/; pybind11 from PyPI: tools/requirements.txt)
           libllvm19)  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison
 missing=()
 for p in "${apt_pkgs[@]}"; do

@@ -8,5 +8,6 @@ scripts/install-deps.sh
 scripts/build.sh "$@"
 ctest --test-dir build --output-on-failure --timeout 1800 -j "$(nproc)"
 if compgen -G "tests/python/test_*.py" >/dev/null; then
-  .venv/bin/python -m pytest -q tests/python
+  # PATHBENCH_SLOW=1: also `pip install .` into a fresh venv once (a full build of the module, minutes)
+  PATHBENCH_SLOW=1 .venv/bin/python -m pytest -q tests/python
 fi

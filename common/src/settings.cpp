@@ -80,6 +80,20 @@ Isa parse_isa(std::string_view s) {
   throw InputError(fmt::format("--isa: unknown instruction set '{}' (expected auto, avx512, avx2 or scalar)", s));
 }
 
+void apply_choices(const RenderChoices& c, RenderSettings& s) {
+  s.sampling = parse_sampling(c.sampling);
+  s.strategy = parse_strategy(c.strategy);
+  s.device = parse_device(c.device);
+  s.precision = parse_precision(c.precision);
+  s.embree_layout = parse_embree_layout(c.embree_layout);
+  s.isa = parse_isa(c.isa);
+  if (c.converged) {
+    s.max_bounces = -1;
+    s.russian_roulette = true;
+  }
+  s.validate();
+}
+
 void RenderSettings::validate() const {
   if (width == 0 || height == 0) throw InputError(fmt::format("--width/--height: the image must be at least 1x1 (got {}x{})", width, height));
   if (uint64_t(width) * height > (uint64_t(1) << 31))

@@ -1,7 +1,8 @@
 // The `pathbench` Python module: load a scene, read its arrays as numpy, cast batches
 // of rays through the CPU tracer's Embree scene or the GPU BVH traversal (run on the
-// host), and render. Heavy work runs with the GIL released; bad input raises
-// ValueError with pathbench's own message (InputError).
+// host), and render (render_binding.cpp). Heavy work runs with the GIL released; bad
+// input raises TypeError (a wrong type, arguments.h) or ValueError (a wrong value, with
+// pathbench's own message from InputError).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -13,11 +14,12 @@
 #include <memory>
 #include <string>
 
-#include "device_render.h"
+#include "arguments.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene_library.h"
 #include "ray_cast.h"
+#include "render_binding.h"
 #include "scene_handle.h"
 
 namespace py = pybind11;
@@ -25,8 +27,9 @@ namespace py = pybind11;
 namespace pb::py_bind {
 namespace {
 
+using pb::python::Batch;
+using pb::python::make_batch;
 using pb::python::SceneHandle;
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
 // A read-only numpy view of `data` that keeps `owner` (the Python Scene) alive.
 template <class T>
@@ -42,65 +45,25 @@ py::array view(const T* data, std::vector<py::ssize_t> shape, const py::object& 
   return a;
 }
 
-FloatArray rows3(const py::object& obj, const char* what) {
-  FloatArray a = FloatArray::ensure(obj);
-  if (!a) throw InputError(fmt::format("{} must be an array of floats of shape (N, 3)", what));
-  if (a.ndim() != 2 || a.shape(1) != 3)
-    throw InputError(fmt::format("{} must have shape (N, 3), got {}", what, std::string(py::str(obj.attr("shape")))));
-  return a;
+// Everything the module initialises lazily behind a function-local static or a
+// first-call import, done once here at import (under the import lock, before any
+// thread can call in): numpy and its C API table, and the dtypes the bindings use.
+// pybind11 >= 2.12 makes these first uses safe from several threads by itself; this
+// keeps the module free of that first-call race whichever pybind11 builds it.
+void initialise_at_import() {
+  py::module_::import("numpy");
+  (void)py::dtype::of<float>();
+  (void)py::dtype::of<uint32_t>();
+  (void)py::dtype::of<bool>();
+  (void)pb::builtin_scenes();
 }
 
-// Ray origins in the user's coordinates, as the scene traces them: minus the scene's
-// origin (Scene::origin, nonzero only for a scene finalize() moved next to the origin),
-// taken in double so that float64 input keeps its digits until that subtraction.
-FloatArray traced_origins(const py::object& obj, Vec3f origin) {
-  FloatArray a = rows3(obj, "origins");
-  if (is_zero(origin)) return a;
-  const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
-  FloatArray out(std::vector<py::ssize_t>{a.shape(0), 3});
-  float* o = out.mutable_data();
-  for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    for (int k = 0; k < 3; ++k) o[3 * i + k] = float(d.at(i, k) - double(origin[k]));
-  return out;
-}
-
-// tnear / tfar: one number for every ray, or an array of shape (N,).
-struct PerRay {
-  FloatArray values;
-  size_t stride;
-};
-PerRay per_ray(const py::object& obj, size_t n, const char* what) {
-  FloatArray a = FloatArray::ensure(obj);
-  if (!a) throw InputError(fmt::format("{} must be a number or an array of shape ({},)", what, n));
-  if (a.ndim() == 0) return {a, 0};
-  if (a.ndim() != 1 || size_t(a.shape(0)) != n)
-    throw InputError(fmt::format("{} must be a number or an array of shape ({},), got shape {}", what, n,
-                                 std::string(py::str(a.attr("shape")))));
-  return {a, 1};
-}
-
-struct Batch {
-  FloatArray o, d;
-  PerRay tn, tf;
-  pb::python::RayBatch rays;
-};
-Batch make_batch(const SceneHandle& s, const py::object& origins, const py::object& directions,
-                 const py::object& tnear, const py::object& tfar) {
-  Batch b{traced_origins(origins, s.scene().origin), rows3(directions, "directions"), {}, {}, {}};
-  const size_t n = size_t(b.o.shape(0));
-  if (size_t(b.d.shape(0)) != n)
-    throw InputError(fmt::format("origins and directions must have the same number of rows ({} != {})", n,
-                                 b.d.shape(0)));
-  b.tn = per_ray(tnear, n, "tnear");
-  b.tf = per_ray(tfar, n, "tfar");
-  b.rays = {b.o.data(), b.d.data(), b.tn.values.data(), b.tf.values.data(), b.tn.stride, b.tf.stride, n};
-  return b;
-}
-
-py::dict intersect(const SceneHandle& s, const py::object& origins, const py::object& directions,
-                   const py::object& tnear, const py::object& tfar, const std::string& backend, bool watertight) {
-  const Batch b = make_batch(s, origins, directions, tnear, tfar);
-  const auto be = pb::python::parse_backend(backend);
+py::dict intersect(const SceneHandle& s, const py::handle& origins, const py::handle& directions,
+                   const py::handle& tnear, const py::handle& tfar, const py::handle& backend_name,
+                   const py::handle& watertight_flag) {
+  const Batch b = make_batch(origins, directions, tnear, tfar, s.scene().origin);
+  const auto be = pb::python::parse_backend(pb::python::str_arg(backend_name, "backend"));
+  const bool watertight = pb::python::bool_arg(watertight_flag, "watertight");
   // Shape as a container: array_t(count) comes out with stride 0 in pybind11 2.10.
   const std::vector<py::ssize_t> shape{py::ssize_t(b.rays.n)};
   py::array_t<bool> hit(shape);
@@ -120,11 +83,12 @@ py::dict intersect(const SceneHandle& s, const py::object& origins, const py::ob
   return out;
 }
 
-py::array_t<bool> occluded(const SceneHandle& s, const py::object& origins, const py::object& directions,
-                           const py::object& tnear, const py::object& tfar, const std::string& backend,
-                           bool watertight) {
-  const Batch b = make_batch(s, origins, directions, tnear, tfar);
-  const auto be = pb::python::parse_backend(backend);
+py::array_t<bool> occluded(const SceneHandle& s, const py::handle& origins, const py::handle& directions,
+                           const py::handle& tnear, const py::handle& tfar, const py::handle& backend_name,
+                           const py::handle& watertight_flag) {
+  const Batch b = make_batch(origins, directions, tnear, tfar, s.scene().origin);
+  const auto be = pb::python::parse_backend(pb::python::str_arg(backend_name, "backend"));
+  const bool watertight = pb::python::bool_arg(watertight_flag, "watertight");
   py::array_t<bool> out(std::vector<py::ssize_t>{py::ssize_t(b.rays.n)});
   bool* o = out.mutable_data();
   {
@@ -140,45 +104,14 @@ std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::arr
       pb::transformed(load_scene(name), scale, Vec3f{offset[0], offset[1], offset[2]}));
 }
 
-py::tuple render(const SceneHandle& s, uint32_t width, uint32_t height, uint32_t spp, int max_bounces,
-                 const std::string& sampling, const std::string& strategy, const std::string& device, uint64_t seed,
-                 bool russian_roulette, uint64_t paths_in_flight, int threads, bool watertight, bool profile) {
-  RenderSettings rs;
-  rs.width = width;
-  rs.height = height;
-  rs.spp = spp;
-  rs.max_bounces = max_bounces;
-  rs.sampling = parse_sampling(sampling);
-  rs.strategy = parse_strategy(strategy);
-  rs.device = parse_device(device);
-  rs.seed = seed;
-  rs.russian_roulette = russian_roulette;
-  rs.paths_in_flight = paths_in_flight;
-  rs.threads = threads;
-  rs.watertight = watertight;
-  rs.progress = false;
-  rs.validate();
-  Film film(width, height, false);
-  RunReport report;
-  std::vector<float> mean;
-  {
-    py::gil_scoped_release release;
-    app::render_on_device(s.scene(), rs, film, report, profile);
-    mean = film.mean();
-  }
-  py::array_t<float> image({py::ssize_t(height), py::ssize_t(width), py::ssize_t(3)});
-  std::copy(mean.begin(), mean.end(), image.mutable_data());
-  py::object report_dict = py::module_::import("json").attr("loads")(report.to_json().dump());
-  return py::make_tuple(image, report_dict);
-}
-
 }  // namespace
 }  // namespace pb::py_bind
 
-PYBIND11_MODULE(pathbench, m) {
+PYBIND11_MODULE(_core, m) {
   using namespace pb::py_bind;
   using pb::python::SceneHandle;
   m.doc() = "pathbench: scenes as numpy arrays, batched ray casts (Embree or the GPU BVH on the host), renders";
+  initialise_at_import();
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -258,11 +191,5 @@ PYBIND11_MODULE(pathbench, m) {
     for (const auto& b : pb::builtin_scenes()) out.append(py::make_tuple(b.name, b.description));
     return out;
   });
-  m.def("render", &render, py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("spp"), py::kw_only(),
-        py::arg("max_bounces") = 2, py::arg("sampling") = "nee", py::arg("strategy") = "pixel",
-        py::arg("device") = "cpu", py::arg("seed") = 0, py::arg("russian_roulette") = false,
-        py::arg("paths_in_flight") = 0, py::arg("threads") = 0, py::arg("watertight") = true,
-        py::arg("profile") = false,
-        "Renders on 'cpu' or 'gpu' (where built). Returns (image float32 (H, W, 3), row 0 at the top; report dict\n"
-        "as in `pathbench render --report`).");
+  pb::python::def_render(m);
 }

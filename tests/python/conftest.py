@@ -13,3 +13,4 @@ sys.path.insert(0, os.environ.get("PATHBENCH_PYTHON_DIR", str(ROOT / "build" / "
 def pytest_configure(config):
     config.addinivalue_line("markers", "oracle_large: the intersection oracle's larger sweep "
                                        "(PATHBENCH_ORACLE_LARGE=1)")
+    config.addinivalue_line("markers", "slow: minutes, e.g. `pip install .` with a full build (PATHBENCH_SLOW=1)")

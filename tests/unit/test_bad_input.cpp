@@ -147,5 +147,27 @@ TEST(BadSettings, UnknownEmbreeLayout) {
   expect_input_error([] { parse_embree_layout("octagons"); }, {"--embree-layout", "'octagons'"});
 }
 
+// apply_choices: the one path from named options to settings, for the CLI and the Python module.
+TEST(Settings, ApplyChoicesParsesEveryNameAndConverged) {
+  RenderSettings s;
+  RenderChoices c{"cosine", "wavefront", "cpu", "double", "quads", true};
+  apply_choices(c, s);
+  EXPECT_EQ(s.sampling, Sampling::Cosine);
+  EXPECT_EQ(s.strategy, Strategy::Wavefront);
+  EXPECT_EQ(s.precision, Precision::Double);
+  EXPECT_EQ(s.embree_layout, EmbreeLayout::Quads);
+  EXPECT_EQ(s.max_bounces, -1);
+  EXPECT_TRUE(s.russian_roulette);
+}
+TEST(BadSettings, ApplyChoicesRefusesWhatParseAndValidateRefuse) {
+  RenderSettings s;
+  RenderChoices c;
+  c.precision = "half";
+  expect_input_error([&] { apply_choices(c, s); }, {"--precision", "'half'"});
+  c = RenderChoices{};
+  s.spp = 0;
+  expect_input_error([&] { apply_choices(c, s); }, {"--spp"});
+}
+
 }  // namespace
 }  // namespace pb

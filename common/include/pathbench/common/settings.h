@@ -66,6 +66,19 @@ struct RenderSettings {
   void validate() const;
 };
 
+// The options users give by name or switch on (`pathbench render` flags, `pathbench.render`
+// keywords), turned into RenderSettings in one place (apply_choices) so that the CLI and
+// the Python module accept and refuse the same things with the same messages.
+struct RenderChoices {
+  std::string sampling = "nee", strategy = "pixel", device = "cpu", precision = "float";
+  std::string embree_layout = "auto";
+  std::string isa = "auto";  // CPU: instruction set of the batched path step
+  bool converged = false;  // unbounded paths ended by Russian roulette (max_bounces = -1, rr on)
+};
+// Parses the names into `s`, applies `converged`, then s.validate(). Throws InputError
+// naming the CLI option (--sampling, ...); the Python module renames those to its keywords.
+void apply_choices(const RenderChoices& c, RenderSettings& s);
+
 const char* to_string(Sampling s);
 const char* to_string(Strategy s);
 const char* to_string(Device d);
