@@ -4,14 +4,17 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numeric>
-#include <regex>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/input_file.h"
+#include "pathbench/common/limits.h"
 
 namespace pb::app {
 
@@ -120,23 +123,58 @@ double unit_to_seconds(const std::string& unit, const std::string& path, const s
 
 }  // namespace
 
-nlohmann::json read_benchmark_json(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file", path));
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot be read", path));
-  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
-  // counter); strict JSON has no NaN, so such values are read as null.
-  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
+namespace {
+
+bool word_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
+// counter); strict JSON has no NaN, so a value NaN, nan, Infinity or inf (after a ':',
+// optionally negative) is read as null. A linear scan: std::regex recurses per
+// character and overflows the stack on long runs of whitespace.
+std::string non_finite_to_null(const std::string& raw) {
+  static const char* const kWords[] = {"NaN", "nan", "Infinity", "inf"};
+  std::string out;
+  out.reserve(raw.size());
+  size_t i = 0;
+  while (i < raw.size()) {
+    out += raw[i];
+    if (raw[i++] != ':') continue;
+    size_t j = i;
+    while (j < raw.size() && std::isspace(static_cast<unsigned char>(raw[j]))) ++j;
+    const size_t value = j;
+    if (j < raw.size() && raw[j] == '-') ++j;
+    for (const char* w : kWords) {
+      const size_t n = std::strlen(w);
+      if (raw.compare(j, n, w) == 0 && (j + n == raw.size() || !word_char(raw[j + n]))) {
+        out.append(raw, i, value - i);
+        out += "null";
+        i = j + n;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json parse_benchmark_json(const std::string& path, const std::string& raw) {
   try {
-    return nlohmann::json::parse(std::regex_replace(raw, non_finite, "$1null"));
+    return nlohmann::json::parse(non_finite_to_null(raw));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
   }
 }
 
+nlohmann::json read_benchmark_json(const std::string& path) {
+  return parse_benchmark_json(path, read_input_file(path, "benchmark JSON file", limits::kMaxBenchJsonBytes));
+}
+
 BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
-  const nlohmann::json j = read_benchmark_json(path);
+  return bench_file_from_json(path, read_benchmark_json(path), min_repetitions);
+}
+
+BenchFile bench_file_from_json(const std::string& path, const nlohmann::json& j, int min_repetitions) try {
   if (!j.is_object() || !j.contains("benchmarks") || !j["benchmarks"].is_array() || !j.contains("context"))
     throw InputError(fmt::format("{}: not Google Benchmark JSON (expected an object with 'context' and a "
                                  "'benchmarks' array; write it with --benchmark_out=FILE.json)",
@@ -181,6 +219,9 @@ BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
     }
   }
   return f;
+} catch (const nlohmann::json::exception& e) {
+  // A field of the wrong type ("name": 5, "run_type": []): bad input, not a failure.
+  throw InputError(fmt::format("{}: not Google Benchmark JSON ({})", path, e.what()));
 }
 
 const char* to_string(Verdict v) {

@@ -83,7 +83,8 @@ class JsonSceneReader {
     return obj[key];
   }
   void allow_keys(const Json& obj, const std::string& field, std::initializer_list<const char*> keys) const {
-    for (const auto& [key, value] : obj.items()) {
+    for (const auto& item : obj.items()) {
+      const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture those
       if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; })) {
         std::string allowed;
         for (const char* k : keys) allowed += (allowed.empty() ? "" : ", ") + std::string(k);
