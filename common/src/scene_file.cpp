@@ -202,7 +202,7 @@ class JsonSceneReader {
       if (t.contains("translate")) translate = vec3(t["translate"], tf + ".translate");
     }
     const fs::path obj = fs::path(path_).parent_path() / file;
-    if (!fs::exists(obj)) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, obj.string()));
+    if (std::error_code ec; !fs::exists(obj, ec) && !ec) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, obj.string()));
     try {
       const std::string text = read_(obj.string(), "mesh file (OBJ)", limits::kMaxMeshBytes);
       mesh_bytes_ += text.size();

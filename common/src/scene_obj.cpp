@@ -149,7 +149,7 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
       if (tok.size() < 2) fail(line_no, "'mtllib' needs a file name");
       for (size_t i = 1; i < tok.size(); ++i) {
         const fs::path mtl = fs::path(path).parent_path() / std::string(tok[i]);
-        if (!fs::exists(mtl))
+        if (std::error_code ec; !fs::exists(mtl, ec) && !ec)
           fail(line_no, fmt::format("material library '{:.80}' not found (looked for {:.200})", tok[i], mtl.string()));
       }
     }
@@ -175,7 +175,7 @@ class MtlReader : public tinyobj::MaterialReader {
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* map, std::string* warn, std::string* err) override {
     const std::string path = (dir_ / name).string();
-    if (!fs::exists(path)) throw InputError(fmt::format("material library '{}' not found (looked for {})", name, path));
+    if (std::error_code ec; !fs::exists(path, ec) && !ec) throw InputError(fmt::format("material library '{}' not found (looked for {})", name, path));
     const std::string text = read_(path, "material library (MTL)", limits::kMaxMtlBytes);
     used_ += text.size();
     if (used_ > limits::kMaxMtlBytes)
