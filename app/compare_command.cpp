@@ -10,10 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <numeric>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
+#include "pathbench/common/json_input.h"
 #include "pathbench/common/limits.h"
 
 namespace pb::app {
@@ -92,7 +95,15 @@ MannWhitneyResult mann_whitney_u(const std::vector<double>& a, const std::vector
   const double u_min = std::min(r.u_a, mn - r.u_a);
 
   if (!ties && m <= 50 && n <= 50) {
-    const std::vector<double> counts = exact_u_counts(m, n);
+    // Cached per (m, n): the table costs O(m^2 n^2) and a file may hold thousands of
+    // benchmarks with the same repetition counts.
+    static std::mutex cache_mutex;
+    static std::map<std::pair<size_t, size_t>, std::vector<double>> cache;
+    std::unique_lock lock(cache_mutex);
+    auto [it, fresh] = cache.try_emplace({m, n});
+    if (fresh) it->second = exact_u_counts(m, n);
+    const std::vector<double> counts = it->second;
+    lock.unlock();
     const double total = std::accumulate(counts.begin(), counts.end(), 0.0);
     double tail = 0;
     for (size_t u = 0; u < counts.size() && double(u) <= u_min + 1e-9; ++u) tail += counts[u];
@@ -160,7 +171,7 @@ std::string non_finite_to_null(const std::string& raw) {
 
 nlohmann::json parse_benchmark_json(const std::string& path, const std::string& raw) {
   try {
-    return nlohmann::json::parse(non_finite_to_null(raw));
+    return parse_json_bounded<nlohmann::json>(non_finite_to_null(raw), path);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
   }

@@ -8,9 +8,11 @@
 #include <filesystem>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
+#include <unordered_map>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
+#include "pathbench/common/json_input.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_library.h"
 #include "scene_io.h"
@@ -34,7 +36,7 @@ class JsonSceneReader {
   Scene read(const std::string& text) {
     Json root;
     try {
-      root = Json::parse(text);
+      root = parse_json_bounded<Json>(text, path_);
     } catch (const Json::exception& e) {
       // "[json.exception.parse_error.101] parse error at line 3, column 1: ..." without the
       // tag; also out_of_range.406, "number overflow parsing '1e999'".
@@ -69,7 +71,8 @@ class JsonSceneReader {
  private:
   std::string path_;
   const FileReader& read_;
-  mutable uint64_t mesh_bytes_ = 0;  // all mesh files read so far: one budget for the scene
+  mutable uint64_t mesh_bytes_ = 0;
+  mutable std::unordered_map<std::string, uint32_t> material_index_;  // name -> first material of that name  // all mesh files read so far: one budget for the scene
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
     if (field.empty()) throw InputError(fmt::format("{}: {}", path_, what));
@@ -124,11 +127,21 @@ class JsonSceneReader {
   }
   uint32_t material(const Scene& s, const Json& j, const std::string& field) const {
     const std::string name = string(j, field);
-    for (size_t i = 0; i < s.material_names.size(); ++i)
-      if (s.material_names[i] == name) return uint32_t(i);
+    // A map, not a search per use: many groups times many materials stays linear.
+    if (material_index_.size() != s.material_names.size()) {
+      material_index_.clear();
+      for (size_t i = 0; i < s.material_names.size(); ++i) material_index_.emplace(s.material_names[i], uint32_t(i));
+    }
+    if (auto it = material_index_.find(name); it != material_index_.end()) return it->second;
     std::string known;
-    for (const std::string& n : s.material_names) known += (known.empty() ? "" : ", ") + n;
-    fail(field, fmt::format("unknown material '{}' (the file defines: {})", name, known));
+    for (const std::string& n : s.material_names) {
+      if (known.size() > 200) {
+        known += ", ...";
+        break;
+      }
+      known += (known.empty() ? "" : ", ") + n;
+    }
+    fail(field, fmt::format("unknown material '{:.80}' (the file defines: {})", name, known));
   }
 
   // {"kind": K, "albedo": [r, g, b], "emission": [r, g, b], "ior": x, "alpha": x}: kind
@@ -202,9 +215,9 @@ class JsonSceneReader {
       if (t.contains("translate")) translate = vec3(t["translate"], tf + ".translate");
     }
     const fs::path obj = fs::path(path_).parent_path() / file;
-    if (std::error_code ec; !fs::exists(obj, ec) && !ec) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, obj.string()));
+    if (!read_.exists(obj.string())) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, obj.string()));
     try {
-      const std::string text = read_(obj.string(), "mesh file (OBJ)", limits::kMaxMeshBytes);
+      const std::string text = read_.read(obj.string(), "mesh file (OBJ)", limits::kMaxMeshBytes);
       mesh_bytes_ += text.size();
       if (mesh_bytes_ > limits::kMaxMeshBytes)
         fail(field + ".file", fmt::format("the mesh files (OBJ) of one scene are limited to {} in all",

@@ -11,9 +11,14 @@
 
 namespace pb::scene_io {
 
-// Returns the contents of `path`; throws InputError (missing, special, over max_bytes).
-using FileReader = std::function<std::string(const std::string& path, const char* what, uint64_t max_bytes)>;
-// read_input_file, with the size limits of pathbench/common/limits.h.
+struct FileReader {
+  // Returns the contents of `path`; throws InputError (missing, special, over max_bytes).
+  std::function<std::string(const std::string& path, const char* what, uint64_t max_bytes)> read;
+  // False only when `path` certainly does not exist (for "not found" messages with
+  // the line or field that names it).
+  std::function<bool(const std::string& path)> exists;
+};
+// read_input_file and std::filesystem::exists.
 FileReader disk_reader();
 
 // `text` is the file at `path` (for messages and to resolve relative names).

@@ -72,7 +72,8 @@ struct UsedMaterial {
 };
 
 // Checks the OBJ text line by line; returns the `usemtl` names with their lines.
-std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::string& text, bool with_materials) {
+std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::string& text, bool with_materials,
+                                         const FileReader& files) {
   auto fail = [&](size_t line, const std::string& what) {
     throw InputError(fmt::format("{}:{}: {}", path, line, what));
   };
@@ -149,7 +150,7 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
       if (tok.size() < 2) fail(line_no, "'mtllib' needs a file name");
       for (size_t i = 1; i < tok.size(); ++i) {
         const fs::path mtl = fs::path(path).parent_path() / std::string(tok[i]);
-        if (std::error_code ec; !fs::exists(mtl, ec) && !ec)
+        if (!files.exists(mtl.string()))
           fail(line_no, fmt::format("material library '{:.80}' not found (looked for {:.200})", tok[i], mtl.string()));
       }
     }
@@ -175,8 +176,7 @@ class MtlReader : public tinyobj::MaterialReader {
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* map, std::string* warn, std::string* err) override {
     const std::string path = (dir_ / name).string();
-    if (std::error_code ec; !fs::exists(path, ec) && !ec) throw InputError(fmt::format("material library '{}' not found (looked for {})", name, path));
-    const std::string text = read_(path, "material library (MTL)", limits::kMaxMtlBytes);
+    const std::string text = read_.read(path, "material library (MTL)", limits::kMaxMtlBytes);
     used_ += text.size();
     if (used_ > limits::kMaxMtlBytes)
       throw InputError(fmt::format("{}: the material libraries (MTL) of one OBJ are limited to {} in all", path,
@@ -195,7 +195,7 @@ class MtlReader : public tinyobj::MaterialReader {
 };
 
 ObjData read_obj(const std::string& path, const std::string& text, bool with_materials, const FileReader& read) {
-  const std::vector<UsedMaterial> used = check_obj_text(path, text, with_materials);
+  const std::vector<UsedMaterial> used = check_obj_text(path, text, with_materials, read);
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
@@ -299,9 +299,14 @@ void add_default_light(Scene& s, Vec3f lo, Vec3f hi) {
 }  // namespace
 
 FileReader disk_reader() {
-  return [](const std::string& path, const char* what, uint64_t max_bytes) {
-    return read_input_file(path, what, max_bytes);
-  };
+  return {[](const std::string& path, const char* what, uint64_t max_bytes) {
+            return read_input_file(path, what, max_bytes);
+          },
+          // With an error code: a symlink loop or a long name is read_input_file's to report.
+          [](const std::string& path) {
+            std::error_code ec;
+            return fs::exists(path, ec) || ec;
+          }};
 }
 
 void append_obj_mesh(Scene& s, const std::string& path, const std::string& text, Vec3f scale, Vec3f translate,

@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 
+#include "compare_command.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
@@ -105,6 +106,32 @@ TEST_F(SpecialFiles, MeshBytesAddUpPerScene) {
     "meshes": [{"file": "m.obj", "material": "grey"}, {"file": "m.obj", "material": "grey"}]})");
   EXPECT_NE(error_of([&] { load_scene(path("s.json")); })
                 .find("meshes[1].file: the mesh files (OBJ) of one scene are limited to 256 MiB in all"),
+            std::string::npos);
+}
+
+// JSON within its size limit that would still cost gigabytes or quadratic time.
+TEST_F(SpecialFiles, JsonDepthAndKeysAreBounded) {
+  write("deep.json", std::string(100000, '['));
+  std::string keys = "{";
+  for (int i = 0; i <= 10000; ++i) keys += (i ? ",\"k" : "\"k") + std::to_string(i) + "\": 0";
+  write("keys.json", keys + "}");
+  for (auto load : {std::function<void(const std::string&)>([](const std::string& p) { load_scene(p); }),
+                    std::function<void(const std::string&)>([](const std::string& p) { app::load_benchmark_json(p, 2); })}) {
+    EXPECT_NE(error_of([&] { load(path("deep.json")); }).find("deep.json: JSON nested deeper than 64 levels"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] { load(path("keys.json")); }).find("keys.json: a JSON object with more than 10000 keys"),
+              std::string::npos);
+  }
+}
+
+TEST_F(SpecialFiles, CompareReadsRegularFilesOnly) {
+  ASSERT_EQ(::mkfifo(path("fifo.json").c_str(), 0600), 0);
+  EXPECT_NE(error_of([&] { app::load_benchmark_json(path("fifo.json"), 2); })
+                .find("is a FIFO; a benchmark JSON file must be a regular file"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { app::load_benchmark_json(dir_.string(), 2); }).find("is a directory"), std::string::npos);
+  write("typed.json", R"({"context": {}, "benchmarks": [{"name": 5}]})");
+  EXPECT_NE(error_of([&] { app::load_benchmark_json(path("typed.json"), 2); }).find("not Google Benchmark JSON"),
             std::string::npos);
 }
 
