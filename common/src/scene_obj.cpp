@@ -9,6 +9,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -84,10 +85,12 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
   uint64_t triangles = 0, references = 0, groups = 0;
   size_t line_no = 0;
   for (size_t start = 0; start < text.size();) {
-    size_t end = text.find('\n', start);
+    // Lines end at "\n", "\r\n" or a lone "\r", as tinyobjloader splits them: a file
+    // of "\r"-separated lines must not pass this check as one long line.
+    size_t end = text.find_first_of("\r\n", start);
     if (end == std::string::npos) end = text.size();
     std::string_view line(text.data() + start, end - start);
-    start = end + 1;
+    start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
     ++line_no;
     if (line.find('\0') != std::string_view::npos) fail(line_no, "binary data: this is not a text OBJ file");
     if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
@@ -160,6 +163,22 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
   return used;
 }
 
+// tinyobjloader's number parser overflows a signed int (undefined behaviour) on an
+// exponent of ten or more digits, and OBJ lines are checked before it sees them but
+// MTL lines are not: refuse such exponents (no real number needs one).
+void check_mtl_exponents(const std::string& path, const std::string& text) {
+  for (size_t i = 1; i + 1 < text.size(); ++i) {
+    if ((text[i] != 'e' && text[i] != 'E') || !(std::isdigit(static_cast<unsigned char>(text[i - 1])) || text[i - 1] == '.'))
+      continue;
+    size_t j = i + 1;
+    if (text[j] == '+' || text[j] == '-') ++j;
+    size_t digits = 0;
+    while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j, ++digits;
+    if (digits > 8)
+      throw InputError(fmt::format("{}: a number with an exponent of {} digits (at byte {})", path, digits, i));
+  }
+}
+
 // A read-only istream over text already in memory (no copy).
 struct MemoryBuf : std::streambuf {
   explicit MemoryBuf(const std::string& s) {
@@ -182,6 +201,7 @@ class MtlReader : public tinyobj::MaterialReader {
       throw InputError(fmt::format("{}: the material libraries (MTL) of one OBJ are limited to {} in all", path,
                                    format_bytes(limits::kMaxMtlBytes)));
     if (text.find('\0') != std::string::npos) throw InputError(fmt::format("{}: binary data: not a text MTL file", path));
+    check_mtl_exponents(path, text);
     MemoryBuf buf(text);
     std::istream in(&buf);
     tinyobj::LoadMtl(map, materials, &in, warn, err);
