@@ -13,6 +13,7 @@
 #include "compare_command.h"
 #include "device_render.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_library.h"
@@ -133,6 +134,22 @@ TEST_F(SpecialFiles, CompareReadsRegularFilesOnly) {
   write("typed.json", R"({"context": {}, "benchmarks": [{"name": 5}]})");
   EXPECT_NE(error_of([&] { app::load_benchmark_json(path("typed.json"), 2); }).find("not Google Benchmark JSON"),
             std::string::npos);
+}
+
+// A reference image whose header asks for 10^10 pixels it does not have.
+TEST_F(SpecialFiles, PfmHeaderMustMatchItsData) {
+  write("lie.pfm", std::string("PF\n100000 100000\n-1.0\n") + std::string(24, '\0'));
+  unsigned w = 0, h = 0;
+  EXPECT_NE(error_of([&] { read_image(path("lie.pfm"), w, h); })
+                .find("a 100000x100000 PFM needs 120000000000 bytes of pixels, the file has 24"),
+            std::string::npos);
+  ASSERT_EQ(::mkfifo(path("fifo.pfm").c_str(), 0600), 0);
+  EXPECT_NE(error_of([&] { read_image(path("fifo.pfm"), w, h); }).find("is a FIFO"), std::string::npos);
+  const std::vector<float> rgb = {1, 2, 3, 4, 5, 6};  // 1 wide, 2 high: row order matters
+  write_image(path("ok.pfm"), rgb, 1, 2);
+  EXPECT_EQ(read_image(path("ok.pfm"), w, h), rgb);
+  EXPECT_EQ(w, 1u);
+  EXPECT_EQ(h, 2u);
 }
 
 TEST(Ranges, OutOfRangeScenesAreInputErrors) {
