@@ -124,6 +124,8 @@ MannWhitneyResult mann_whitney_u(const std::vector<double>& a, const std::vector
 
 namespace {
 
+constexpr size_t kMaxBenchmarkName = 1024;
+
 double unit_to_seconds(const std::string& unit, const std::string& path, const std::string& name) {
   if (unit == "ns") return 1e-9;
   if (unit == "us") return 1e-6;
@@ -197,6 +199,10 @@ BenchFile bench_file_from_json(const std::string& path, const nlohmann::json& j,
     if (!b.is_object() || !b.contains("name"))
       throw InputError(fmt::format("{}: a 'benchmarks' entry has no 'name'", path));
     const std::string name = b.value("run_name", b["name"].get<std::string>());
+    // The table pads every row to the longest name: a megabyte name times thousands of
+    // rows would be gigabytes of output.
+    if (name.size() > kMaxBenchmarkName)
+      throw InputError(fmt::format("{}: a benchmark name of {} bytes (at most {})", path, name.size(), kMaxBenchmarkName));
     const std::string run_type = b.value("run_type", "iteration");
     if (!f.series.count(name)) f.order.push_back(name);
     BenchSeries& s = f.series[name];

@@ -17,6 +17,7 @@
 #include <set>
 #include <streambuf>
 #include <string_view>
+#include <unordered_set>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
@@ -82,7 +83,7 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
   int64_t vertices = 0;
   int64_t max_ref = 0;  // the largest absolute vertex index, and its line
   size_t max_ref_line = 0;
-  uint64_t triangles = 0, references = 0, groups = 0;
+  uint64_t triangles = 0, references = 0, groups = 0, usemtl = 0;
   size_t line_no = 0;
   for (size_t start = 0; start < text.size();) {
     // Lines end at "\n", "\r\n" or a lone "\r", as tinyobjloader splits them: a file
@@ -148,6 +149,8 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
       if (++groups > kMaxGroups) fail(line_no, fmt::format("more than {} groups and objects ('g', 'o')", kMaxGroups));
     } else if (kw == "usemtl") {
       if (tok.size() < 2) fail(line_no, "'usemtl' needs a material name");
+      // tinyobjloader warns (a string per use) about unknown names: bounded here.
+      if (++usemtl > kMaxGroups) fail(line_no, fmt::format("more than {} 'usemtl' statements", kMaxGroups));
       used.push_back({std::string(tok[1]), line_no});
     } else if (kw == "mtllib" && with_materials) {
       if (tok.size() < 2) fail(line_no, "'mtllib' needs a file name");
@@ -239,10 +242,10 @@ ObjData read_obj(const std::string& path, const std::string& text, bool with_mat
   mesh.positions.reserve(v.size() / 3);
   for (size_t i = 0; i + 2 < v.size(); i += 3) mesh.positions.push_back({v[i], v[i + 1], v[i + 2]});
   if (with_materials) {
+    std::unordered_set<std::string_view> names;  // a set: many uses times many materials stays linear
+    for (const tinyobj::material_t& m : mesh.materials) names.insert(m.name);
     for (const UsedMaterial& u : used) {
-      const bool known = std::any_of(mesh.materials.begin(), mesh.materials.end(),
-                                     [&](const tinyobj::material_t& m) { return m.name == u.name; });
-      if (!known)
+      if (!names.count(u.name))
         throw InputError(fmt::format("{}:{}: usemtl '{:.80}': no such material in the file's material libraries (mtllib)",
                                      path, u.line, u.name));
     }

@@ -134,6 +134,10 @@ TEST_F(SpecialFiles, CompareReadsRegularFilesOnly) {
   write("typed.json", R"({"context": {}, "benchmarks": [{"name": 5}]})");
   EXPECT_NE(error_of([&] { app::load_benchmark_json(path("typed.json"), 2); }).find("not Google Benchmark JSON"),
             std::string::npos);
+  write("long.json", R"({"context": {}, "benchmarks": [{"name": ")" + std::string(2000, 'x') + R"("}]})");
+  EXPECT_NE(error_of([&] { app::load_benchmark_json(path("long.json"), 2); })
+                .find("a benchmark name of 2000 bytes (at most 1024)"),
+            std::string::npos);
 }
 
 // A reference image whose header asks for 10^10 pixels it does not have.
