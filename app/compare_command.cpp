@@ -4,15 +4,21 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <numeric>
-#include <regex>
 
 #include "compare_context.h"
 #include "pathbench/common/errors.h"
+#include "pathbench/common/input_file.h"
+#include "pathbench/common/json_input.h"
+#include "pathbench/common/limits.h"
 
 namespace pb::app {
 
@@ -93,7 +99,15 @@ MannWhitneyResult mann_whitney_u(const std::vector<double>& a, const std::vector
   const double u_min = std::min(r.u_a, mn - r.u_a);
 
   if (!ties && m <= 50 && n <= 50) {
-    const std::vector<double> counts = exact_u_counts(m, n);
+    // Cached per (m, n): the table costs O(m^2 n^2) and a file may hold thousands of
+    // benchmarks with the same repetition counts.
+    static std::mutex cache_mutex;
+    static std::map<std::pair<size_t, size_t>, std::vector<double>> cache;
+    std::unique_lock lock(cache_mutex);
+    auto [it, fresh] = cache.try_emplace({m, n});
+    if (fresh) it->second = exact_u_counts(m, n);
+    const std::vector<double> counts = it->second;
+    lock.unlock();
     const double total = std::accumulate(counts.begin(), counts.end(), 0.0);
     double tail = 0;
     for (size_t u = 0; u < counts.size() && double(u) <= u_min + 1e-9; ++u) tail += counts[u];
@@ -114,6 +128,8 @@ MannWhitneyResult mann_whitney_u(const std::vector<double>& a, const std::vector
 
 namespace {
 
+constexpr size_t kMaxBenchmarkName = 1024;
+
 double unit_to_seconds(const std::string& unit, const std::string& path, const std::string& name) {
   if (unit == "ns") return 1e-9;
   if (unit == "us") return 1e-6;
@@ -124,27 +140,67 @@ double unit_to_seconds(const std::string& unit, const std::string& path, const s
 
 }  // namespace
 
+namespace {
+
+bool word_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
+// counter); strict JSON has no NaN, so a value NaN, nan, Infinity or inf (after a ':',
+// optionally negative) is read as null. A linear scan: std::regex recurses per
+// character and overflows the stack on long runs of whitespace.
+std::string non_finite_to_null(const std::string& raw) {
+  static const char* const kWords[] = {"NaN", "nan", "Infinity", "inf"};
+  std::string out;
+  out.reserve(raw.size());
+  size_t i = 0;
+  while (i < raw.size()) {
+    out += raw[i];
+    if (raw[i++] != ':') continue;
+    size_t j = i;
+    while (j < raw.size() && std::isspace(static_cast<unsigned char>(raw[j]))) ++j;
+    const size_t value = j;
+    if (j < raw.size() && raw[j] == '-') ++j;
+    for (const char* w : kWords) {
+      const size_t n = std::strlen(w);
+      if (raw.compare(j, n, w) == 0 && (j + n == raw.size() || !word_char(raw[j + n]))) {
+        out.append(raw, i, value - i);
+        out += "null";
+        i = j + n;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// The same text as ordered JSON (key order kept), for rewriting a bench file in place.
 nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const std::string& path) {
-  // Google Benchmark writes NaN for undefined aggregates (e.g. the cv of a constant
-  // counter); strict JSON has no NaN, so such values are read as null.
-  static const std::regex non_finite(R"((:\s*)-?(NaN|nan|Infinity|inf)\b)");
   try {
-    return nlohmann::ordered_json::parse(std::regex_replace(raw, non_finite, "$1null"));
+    return parse_json_bounded<nlohmann::ordered_json>(non_finite_to_null(raw), path);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
+  }
+}
+
+nlohmann::json parse_benchmark_json(const std::string& path, const std::string& raw) {
+  try {
+    return parse_json_bounded<nlohmann::json>(non_finite_to_null(raw), path);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
   }
 }
 
 nlohmann::json read_benchmark_json(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: no such file", path));
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot be read", path));
-  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return nlohmann::json(parse_benchmark_json_text(raw, path));
+  return parse_benchmark_json(path, read_input_file(path, "benchmark JSON file", limits::kMaxBenchJsonBytes));
 }
 
 BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
-  const nlohmann::json j = read_benchmark_json(path);
+  return bench_file_from_json(path, read_benchmark_json(path), min_repetitions);
+}
+
+BenchFile bench_file_from_json(const std::string& path, const nlohmann::json& j, int min_repetitions) try {
   if (!j.is_object() || !j.contains("benchmarks") || !j["benchmarks"].is_array() || !j.contains("context"))
     throw InputError(fmt::format("{}: not Google Benchmark JSON (expected an object with 'context' and a "
                                  "'benchmarks' array; write it with --benchmark_out=FILE.json)",
@@ -157,6 +213,10 @@ BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
     if (!b.is_object() || !b.contains("name"))
       throw InputError(fmt::format("{}: a 'benchmarks' entry has no 'name'", path));
     const std::string name = b.value("run_name", b["name"].get<std::string>());
+    // The table pads every row to the longest name: a megabyte name times thousands of
+    // rows would be gigabytes of output.
+    if (name.size() > kMaxBenchmarkName)
+      throw InputError(fmt::format("{}: a benchmark name of {} bytes (at most {})", path, name.size(), kMaxBenchmarkName));
     const std::string run_type = b.value("run_type", "iteration");
     if (!f.series.count(name)) f.order.push_back(name);
     BenchSeries& s = f.series[name];
@@ -202,6 +262,9 @@ BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
     }
   }
   return f;
+} catch (const nlohmann::json::exception& e) {
+  // A field of the wrong type ("name": 5, "run_type": []): bad input, not a failure.
+  throw InputError(fmt::format("{}: not Google Benchmark JSON ({})", path, e.what()));
 }
 
 const char* to_string(Verdict v) {

@@ -69,9 +69,12 @@ nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const s
 // The file as JSON, with Google Benchmark's bare NaN / inf values read as null.
 // Throws InputError when it is missing or not JSON.
 nlohmann::json read_benchmark_json(const std::string& path);
+// The same for text already read (`path` names it in messages).
+nlohmann::json parse_benchmark_json(const std::string& path, const std::string& text);
 // Throws InputError: missing or unreadable file, not Google Benchmark JSON, or a
 // benchmark with fewer than `min_repetitions` repetitions.
 BenchFile load_benchmark_json(const std::string& path, int min_repetitions);
+BenchFile bench_file_from_json(const std::string& path, const nlohmann::json& j, int min_repetitions);
 
 // Contended: wall time regressed, process CPU time did not (another process had the
 // cores). Invalid: a median time of zero, which measures nothing.

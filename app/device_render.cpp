@@ -10,6 +10,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/cpu/embree_facts.h"
+#include "pathbench/common/limits.h"
 #include "pathbench/cpu/render.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/device_facts.h"
@@ -67,6 +68,20 @@ nlohmann::json load_between(const nlohmann::json& start, const nlohmann::json& e
           {"cpu_per_wall", wall > 0 ? nlohmann::json(cpu / wall) : nlohmann::json(nullptr)}};
 }
 
+// A film where most samples were discarded (NaN, infinite, or beyond its fixed-point
+// range) is wrong, not noisy: fail rather than write it. Within the supported emission
+// range this takes extreme geometry (a light 1e-10 from a wall, say).
+void check_discarded(const Scene& scene, const RenderSettings& s, const RunReport& report) {
+  const double samples = double(s.width) * double(s.height) * double(s.spp);
+  const double discarded = double(report.discarded_samples);
+  if (samples > 0 && discarded > limits::kMaxDiscardedFraction * samples)
+    throw InputError(fmt::format("{}: {} of {} samples ({:.1f}%) were discarded as NaN, infinite or beyond the "
+                                 "film's range; the image would be wrong, so none is written (emission is "
+                                 "limited to {:g}; very bright lights very close to surfaces also overflow)",
+                                 scene.name, report.discarded_samples, uint64_t(samples), 100 * discarded / samples,
+                                 limits::kMaxEmission));
+}
+
 void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile) {
   const nlohmann::json start = load_sample();
   if (s.device == Device::Cpu) {
@@ -82,6 +97,7 @@ void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, R
   }
   report.load = load_between(start, load_sample());
   report.fingerprint = run_fingerprint(s.device == Device::Gpu);
+  check_discarded(scene, s, report);
 }
 
 double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }

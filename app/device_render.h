@@ -17,6 +17,9 @@ namespace pb::app {
 // report's fingerprint and its load (load average, process CPU and wall time around
 // the render, so that a contended run can be told from a slow one).
 void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile);
+// Throws InputError when more than limits::kMaxDiscardedFraction of the render's
+// samples were discarded (render_on_device calls it after every render).
+void check_discarded(const Scene& scene, const RenderSettings& s, const RunReport& report);
 // True when this build has the CUDA tracer and a device is present; otherwise sets
 // *why_not (if given) to the reason.
 bool gpu_available(std::string* why_not);

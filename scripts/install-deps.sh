@@ -11,7 +11,8 @@ apt_pkgs=(build-essential cmake ninja-build ccache pkg-config git python3 python
           librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
           libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev
           python3-dev  # the `pathbench` Python module (python/; pybind11 from PyPI: tools/requirements.txt)
-          libllvm19)  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison
+          libllvm19  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison
+          clang libfuzzer-14-dev)  # the fuzz targets (scripts/fuzz.sh): libFuzzer + ASan + UBSan
 missing=()
 for p in "${apt_pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

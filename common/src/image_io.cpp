@@ -9,9 +9,12 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/input_file.h"
+#include "pathbench/common/limits.h"
 #include "pathbench/common/output_file.h"
 
 #if PATHBENCH_HAVE_OIIO
@@ -105,17 +108,28 @@ void write_oiio(OutputFile& f, const std::string& ext, const std::vector<float>&
 }
 #endif
 
+// Read through read_input_file (regular files only, bounded); the header's size must
+// match the data, so a hostile header cannot ask for a huge allocation.
 std::vector<float> read_pfm(const std::string& path, unsigned& w, unsigned& h) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path));
+  const std::string data = read_input_file(path, "image file (PFM)", limits::kMaxImageBytes);
+  std::istringstream in(data.substr(0, std::min<size_t>(data.size(), 256)));
   std::string magic;
-  double scale;
-  in >> magic >> w >> h >> scale;
-  in.get();
-  if (magic != "PF" || !in || scale >= 0) throw std::runtime_error(fmt::format("{}: not a little-endian RGB PFM", path));
+  uint64_t w64 = 0, h64 = 0;
+  double scale = 0;
+  in >> magic >> w64 >> h64 >> scale;
+  if (magic != "PF" || !in || !(scale < 0) || w64 == 0 || h64 == 0 || w64 > (1u << 30) || h64 > (1u << 30))
+    throw InputError(fmt::format("{}: not a little-endian RGB PFM", path));
+  const size_t header = size_t(in.tellg()) + 1;  // one whitespace byte after the scale
+  const uint64_t bytes = w64 * h64 * 12;
+  if (header > data.size() || data.size() - header != bytes)
+    throw InputError(fmt::format("{}: a {}x{} PFM needs {} bytes of pixels, the file has {}", path, w64, h64, bytes,
+                                 data.size() < header ? 0 : data.size() - header));
+  w = unsigned(w64);
+  h = unsigned(h64);
   std::vector<float> rgb(size_t(w) * h * 3);
-  for (unsigned y = h; y-- > 0;) in.read(reinterpret_cast<char*>(&rgb[size_t(y) * w * 3]), std::streamsize(w) * 3 * 4);
-  if (!in) throw std::runtime_error(fmt::format("{}: truncated", path));
+  const size_t row = size_t(w) * 3 * sizeof(float);
+  for (unsigned y = 0; y < h; ++y)  // rows bottom to top
+    std::memcpy(&rgb[size_t(h - 1 - y) * w * 3], data.data() + header + y * row, row);
   return rgb;
 }
 

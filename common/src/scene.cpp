@@ -6,12 +6,18 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/features.h"
+#include "pathbench/common/limits.h"
 
 namespace pb {
 
 namespace {
 bool finite(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool non_negative(Vec3f v) { return v.x >= 0 && v.y >= 0 && v.z >= 0; }
+// Inside the supported coordinate range (limits.h); false for NaN.
+bool in_range(Vec3f v) {
+  const float m = float(limits::kMaxCoordinate);
+  return std::fabs(v.x) <= m && std::fabs(v.y) <= m && std::fabs(v.z) <= m;
+}
 }  // namespace
 
 const char* to_string(MaterialKind k) {
@@ -29,10 +35,18 @@ void Scene::finalize() {
   if (material_ids.size() != triangles.size())
     throw InputError(fmt::format("{}: {} triangles but {} material ids", name, triangles.size(), material_ids.size()));
   if (materials.empty()) throw InputError(fmt::format("{}: the scene has no materials", name));
-  for (size_t i = 0; i < positions.size(); ++i)
+  if (triangles.size() > limits::kMaxTriangles)
+    throw InputError(fmt::format("{}: {} triangles; the supported maximum is {}", name, triangles.size(),
+                                 limits::kMaxTriangles));
+  for (size_t i = 0; i < positions.size(); ++i) {
     if (!finite(positions[i]))
       throw InputError(fmt::format("{}: vertex {} has a NaN or infinite coordinate ({}, {}, {})", name, i,
                                    positions[i].x, positions[i].y, positions[i].z));
+    if (!in_range(positions[i]))
+      throw InputError(fmt::format("{}: vertex {} ({:g}, {:g}, {:g}) is outside the supported coordinate range "
+                                   "+-{:g} (after any transform)", name, i, positions[i].x, positions[i].y,
+                                   positions[i].z, limits::kMaxCoordinate));
+  }
   for (size_t i = 0; i < materials.size(); ++i) {
     const Material& m = materials[i];
     std::string mname = i < material_names.size() ? material_names[i] : std::to_string(i);
@@ -42,6 +56,10 @@ void Scene::finalize() {
       throw InputError(fmt::format("{}: material '{}' has an albedo above 1 (it would create energy)", name, mname));
     if (!finite(m.emission) || !non_negative(m.emission))
       throw InputError(fmt::format("{}: material '{}' has an emission that is negative, NaN or infinite", name, mname));
+    if (max_component(m.emission) > float(limits::kMaxEmission))
+      throw InputError(fmt::format("{}: material '{}' has emission {:g}, above the supported maximum {:g} (the "
+                                   "film's fixed-point sums and float samples cannot represent it)",
+                                   name, mname, max_component(m.emission), limits::kMaxEmission));
     if (uint32_t(m.kind) >= kMaterialKindCount)
       throw InputError(fmt::format("{}: material '{}' has an unknown kind {}", name, mname, uint32_t(m.kind)));
     if (m.kind == MaterialKind::Dielectric && !(m.ior > 0 && std::isfinite(m.ior)))
@@ -53,6 +71,10 @@ void Scene::finalize() {
   if (!finite(camera.position) || !finite(camera.forward) || !finite(camera.up) || !finite(camera.right) ||
       !(camera.tan_half_fov_y > 0) || !std::isfinite(camera.tan_half_fov_y))
     throw InputError(fmt::format("{}: the camera is degenerate (NaN, zero direction or field of view)", name));
+  if (!in_range(camera.position))
+    throw InputError(fmt::format("{}: the camera position ({:g}, {:g}, {:g}) is outside the supported coordinate "
+                                 "range +-{:g}", name, camera.position.x, camera.position.y, camera.position.z,
+                                 limits::kMaxCoordinate));
 
   // Indices in range; zero-area triangles dropped (they can never be hit, and they
   // would give NaN normals).
@@ -74,6 +96,11 @@ void Scene::finalize() {
     Vec3f e2 = positions[t.v[2]] - positions[t.v[0]];
     Vec3f c = cross(e1, e2);
     float area2 = length(c);
+    // Edges inside the range whose cross product overflows float: the normal cannot be
+    // computed. Not a zero-area triangle, so not dropped silently.
+    if (finite(c) && std::isinf(area2))
+      throw InputError(fmt::format("{}: triangle {} is too large for float arithmetic (its normal overflows: keep "
+                                   "triangle edges below about 1e9)", name, i));
     if (!(area2 > 0) || !std::isfinite(area2) || !finite(normalize(c))) {
       ++dropped_triangles;
       continue;
@@ -123,6 +150,9 @@ void Scene::finalize() {
   }
   if (!emitter_cdf.empty()) emitter_cdf.back() = 1.0f;
   emitter_power_total = float(total);
+  if (!std::isfinite(emitter_power_total))
+    throw InputError(fmt::format("{}: the emitters' total power (area x emission, {:g}) overflows float; make the "
+                                 "lights smaller or dimmer", name, total));
   features.has_emitters = !emitters.empty();
   if (const uint32_t missing = features.material_kinds & ~kCompiledMaterialKinds) {
     std::string kinds;

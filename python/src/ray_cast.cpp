@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/limits.h"
 #include "pathbench/gpu/bvh.h"
 
 namespace pb::python {
@@ -21,6 +22,12 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 Vec3f row(const float* a, size_t i) { return {a[3 * i], a[3 * i + 1], a[3 * i + 2]}; }
 
 bool finite(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+// Inside the supported coordinate range (limits.h): Embree aborts the process on ray
+// origins or directions beyond ~1.8e18, so larger values never reach it.
+bool in_range(Vec3f v) {
+  const float m = float(limits::kMaxCoordinate);
+  return std::fabs(v.x) <= m && std::fabs(v.y) <= m && std::fabs(v.z) <= m;
+}
 
 void fill(const RayBatch& r, size_t i, RTCRay& e) {
   e.org_x = r.origins[3 * i]; e.org_y = r.origins[3 * i + 1]; e.org_z = r.origins[3 * i + 2];
@@ -55,6 +62,13 @@ void validate(const RayBatch& r, Backend backend, bool watertight) {
     if (!finite(o)) throw InputError(fmt::format("origins[{}] is not finite: ({}, {}, {})", i, o.x, o.y, o.z));
     if (!finite(d)) throw InputError(fmt::format("directions[{}] is not finite: ({}, {}, {})", i, d.x, d.y, d.z));
     if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) throw InputError(fmt::format("directions[{}] is zero", i));
+    if (!in_range(o))
+      throw InputError(fmt::format("origins[{}] = ({:g}, {:g}, {:g}) is outside the supported coordinate range +-{:g}",
+                                   i, o.x, o.y, o.z, limits::kMaxCoordinate));
+    if (!in_range(d))
+      throw InputError(fmt::format("directions[{}] = ({:g}, {:g}, {:g}) is outside the supported range +-{:g} "
+                                   "(directions need not be normalised, but must be that small)",
+                                   i, d.x, d.y, d.z, limits::kMaxCoordinate));
     const float tn = r.tnear_at(i), tf = r.tfar_at(i);
     if (!(std::isfinite(tn) && tn >= 0.0f))
       throw InputError(fmt::format("tnear[{}] = {}: must be finite and >= 0", i, tn));

@@ -69,7 +69,10 @@ const std::vector<BuiltinSceneInfo>& builtin_scenes() {
 Scene load_scene(const std::string& spec) {
   if (spec.empty()) throw InputError("--scene: empty scene name");
   if (ends_with(spec, ".json") || ends_with(spec, ".obj") || spec.find('/') != std::string::npos) {
-    if (!std::filesystem::exists(spec)) throw InputError(fmt::format("{}: no such file", spec));
+    // exists() with an error code: a symlink loop or a long name is read_input_file's
+    // to report, not an exception here.
+    std::error_code ec;
+    if (!std::filesystem::exists(spec, ec) && !ec) throw InputError(fmt::format("{}: no such file", spec));
     if (ends_with(spec, ".json")) return load_scene_json(spec);
     if (ends_with(spec, ".obj")) return load_scene_obj(spec);
     throw InputError(fmt::format("{}: unknown scene file type (expected .json or .obj)", spec));

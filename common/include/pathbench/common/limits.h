@@ -1,0 +1,41 @@
+#pragma once
+// The ranges pathbench supports, in one place: every reader and every check (scene
+// finalize, the scene-file readers, the Python ray arrays, compare's readers) uses
+// these constants, and the README documents them. Input outside them is a user error
+// (InputError: exit 2, or ValueError in Python), refused before Embree or the film
+// sees it.
+#include <cstdint>
+
+namespace pb::limits {
+
+// Largest |coordinate| of a vertex (after a mesh's transform), of the camera position
+// and of a ray origin or direction component. Embree asserts (and aborts the process)
+// on ray origins or directions beyond about 1.8e18; 1e15 leaves a margin of ~1800 for
+// hit points and offsets, and keeps a scene-sized distance squared (~1e31) far inside
+// float range.
+inline constexpr double kMaxCoordinate = 1e15;
+
+// Largest emitted radiance per channel. The film sums samples in 64-bit fixed point
+// scaled from the brightest emission, and a sample is computed in float (max 3.4e38):
+// a path may carry up to ~1024 x the emission (MIS, bounces), so 1e20 leaves ~1e15 of
+// headroom for throughput and geometry terms before a sample overflows to infinity.
+inline constexpr double kMaxEmission = 1e20;
+
+// Triangles in one scene (after triangulating OBJ polygons). Above scaling:10^7, the
+// largest built-in scene; bounds memory (scene + Embree BVH stay a few GB).
+inline constexpr uint64_t kMaxTriangles = uint64_t(1) << 24;
+
+// A render fails (exit 2, no output) when more than this fraction of its samples was
+// discarded (NaN, infinite, or beyond the film's fixed-point range): the image would
+// be wrong, not noisy.
+inline constexpr double kMaxDiscardedFraction = 0.5;
+
+// File sizes, each named in its error message. JSON is parsed into a DOM of about 20x
+// its size at worst, OBJ meshes into index arrays of about 5x.
+inline constexpr uint64_t kMaxSceneJsonBytes = uint64_t(64) << 20;   // JSON scene files
+inline constexpr uint64_t kMaxMeshBytes = uint64_t(256) << 20;       // OBJ files, and all of one scene's OBJ files together
+inline constexpr uint64_t kMaxMtlBytes = uint64_t(16) << 20;         // MTL material libraries
+inline constexpr uint64_t kMaxBenchJsonBytes = uint64_t(64) << 20;   // compare's benchmark JSON files
+inline constexpr uint64_t kMaxImageBytes = uint64_t(1) << 30;        // reference images (.pfm)
+
+}  // namespace pb::limits
