@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass
 
 from . import store
 
-DEFAULT_MAX_PVALUE = 0.001
+DEFAULT_MAX_PVALUE = 1e-4  # 0 false positives in 100 noise-only series (false_positives.py)
 DEFAULT_MIN_CHANGE = 0.005  # 0.5%: below it, a step is not worth a reviewer's time
 WINDOW = 50
 
@@ -39,6 +39,7 @@ class Change:
     benchmark: str
     machine: str
     machine_id: str
+    preset: str
     commit: str
     previous_commit: str
     index: int
@@ -49,20 +50,21 @@ class Change:
     regression: bool
 
 
-def series(db, benchmark: str | None = None, machine: str | None = None) -> dict[tuple[str, str], list[Point]]:
-    """{(benchmark, machine_id): points in commit order}; machine matches a machine's name or id prefix."""
+def series(db, benchmark: str | None = None, machine: str | None = None) -> dict[tuple[str, str, str], list[Point]]:
+    """{(benchmark, machine_id, preset): points in commit order}; machine matches a machine's name or id
+    prefix. The preset is part of the key: one benchmark name under two presets measures different work."""
     rows = db.execute(
-        "SELECT r.benchmark, u.machine_id, u.id, u.commit_sha, COALESCE(u.commit_date, u.run_date), r.value "
+        "SELECT r.benchmark, u.machine_id, COALESCE(u.preset, ''), u.id, u.commit_sha, COALESCE(u.commit_date, u.run_date), r.value "
         "FROM results r JOIN runs u ON u.id = r.run_id JOIN machines m ON m.id = u.machine_id "
         "WHERE r.value IS NOT NULL AND (? IS NULL OR m.name = ? OR m.id LIKE ? || '%') "
         "ORDER BY COALESCE(u.commit_date, u.run_date), u.run_date, u.id, r.repetition",
         (machine, machine, machine)).fetchall()
     pattern = re.compile(benchmark) if benchmark else None
     out: dict[tuple[str, str], list[Point]] = {}
-    for bench, mid, rid, commit, date, value in rows:
+    for bench, mid, preset, rid, commit, date, value in rows:
         if pattern and not pattern.search(bench):
             continue
-        pts = out.setdefault((bench, mid), [])
+        pts = out.setdefault((bench, mid, preset), [])
         if pts and pts[-1].run_id == rid:
             pts[-1].values.append(value)
         else:
@@ -85,22 +87,23 @@ def detect(values: list[float], max_pvalue: float = DEFAULT_MAX_PVALUE, min_chan
 def find(db, benchmark=None, machine=None, max_pvalue=DEFAULT_MAX_PVALUE, min_change=DEFAULT_MIN_CHANGE) -> list[Change]:
     names = dict(db.execute("SELECT id, name FROM machines").fetchall())
     found = []
-    for (bench, mid), pts in sorted(series(db, benchmark, machine).items()):
+    for (bench, mid, preset), pts in sorted(series(db, benchmark, machine).items()):
         medians = [p.median for p in pts]
         for idx, change, p in detect(medians, max_pvalue, min_change):
             before = medians[:idx]
             after = medians[idx:]
-            found.append(Change(bench, names[mid], mid, pts[idx].commit, pts[idx - 1].commit, idx, change, p,
+            found.append(Change(bench, names[mid], mid, preset, pts[idx].commit, pts[idx - 1].commit, idx, change, p,
                                 statistics.fmean(before), statistics.fmean(after), change > 0))
     return found
 
 
 def newest_after_regression(changes: list[Change]) -> list[Change]:
     """Per series, its last change point if it is a regression: the newest run still sits after it."""
-    last: dict[tuple[str, str], Change] = {}
+    last: dict[tuple[str, str, str], Change] = {}
     for c in changes:
-        if (c.benchmark, c.machine_id) not in last or c.index > last[(c.benchmark, c.machine_id)].index:
-            last[(c.benchmark, c.machine_id)] = c
+        key = (c.benchmark, c.machine_id, c.preset)
+        if key not in last or c.index > last[key].index:
+            last[key] = c
     return [c for c in last.values() if c.regression]
 
 

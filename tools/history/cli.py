@@ -105,7 +105,11 @@ def cmd_report(a) -> int:
         db = _open(a.db)
     except (FileNotFoundError, store.SchemaError) as e:
         return _err(str(e))
-    n = report.write_site(db, a.out, commit_url=a.commit_url, png=not a.no_png, repo=a.repo)
+    import re
+    try:
+        n = report.write_site(db, a.out, commit_url=a.commit_url, png=not a.no_png, repo=a.repo, benchmark=a.benchmark)
+    except re.error as e:
+        return _err(f"--benchmark: not a regular expression: {e}")
     print(f"wrote {a.out}/index.html: {n} series")
     return 0
 
@@ -145,6 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--commit-url", default="", help="link template for commits, e.g. https://host/repo/commit/{}")
     p.add_argument("--repo", default=ROOT, help="git repository for commit subjects")
     p.add_argument("--no-png", action="store_true", help="skip the matplotlib PNG copies")
+    p.add_argument("--benchmark", help="regular expression: only these benchmarks")
     p.set_defaults(fn=cmd_report)
 
     p = sub.add_parser("backfill", help="build and measure each commit of a range", add_help=False)
