@@ -191,3 +191,39 @@ def test_dashboard_draws_in_headless_chromium_without_console_errors(tmp_path):
     assert 'data-drawn="32"' in dom
     assert dom.count('class="median"') == 32 and dom.count('class="rep"') >= 16 * 20 * 9
     assert dom.count('class="cp slower"') == 2 * 2  # two stepped series, marked on both of their charts
+
+
+PATHBENCH = ROOT / "build" / "bin" / "pathbench"
+
+
+@pytest.mark.skipif(not PATHBENCH.exists(), reason="build/bin/pathbench not built (scripts/build.sh)")
+def test_pathbench_history_hands_over_and_passes_the_exit_status(tmp_path):
+    env = os.environ | {"PATHBENCH_PYTHON": sys.executable}
+    r = subprocess.run([PATHBENCH, "history", "record", "--db", tmp_path / "h.sqlite", "--export", "", QUICK],
+                       capture_output=True, text=True, env=env)
+    assert r.returncode == 0 and "144 rows" in r.stdout
+    r = subprocess.run([PATHBENCH, "history", "record", "--db", tmp_path / "h.sqlite", "--export", "", QUICK],
+                       capture_output=True, text=True, env=env)
+    assert r.returncode == 2 and "already recorded" in r.stderr
+    r = subprocess.run([PATHBENCH, "history", "changes", "--db", tmp_path / "h.sqlite", "--json"],
+                       capture_output=True, text=True, env=env)
+    assert r.returncode == 0 and json.loads(r.stdout) == []
+    assert "history" in subprocess.run([PATHBENCH, "--help"], capture_output=True, text=True).stdout
+
+
+@pytest.mark.skipif(not PATHBENCH.exists() or shutil.which("valgrind") is None,
+                    reason="needs build/bin/pathbench and valgrind (scripts/install-deps.sh)")
+def test_instruction_count_preset_is_a_bench_json_history_records(tmp_path):
+    """Four callgrind runs of an 8x8, 1 spp render (about 40 s of CPU in all, mostly valgrind start-up)."""
+    from history import instructions
+    data = instructions.measure(str(PATHBENCH), wall_reps=1, revision="0" * 40, width=8, spp=1)
+    names = {b["name"] for b in data["benchmarks"]}
+    for s in ("pixel", "wavefront"):
+        assert f"callgrind/paper-cornell/{s}/default/instructions" in names
+        assert f"wall/paper-cornell/{s}/triangles/128x128/spp:16" in names
+    counted = [b for b in data["benchmarks"] if b["time_unit"] == "instructions"]
+    # Instructions per sample of a 64-sample render: thousands (startup and the BVH build are outside).
+    assert all(1000 < b["real_time"] < 100000 and b["instructions"] == b["real_time"] * 64 for b in counted)
+    p = tmp_path / "instr.json"
+    p.write_text(json.dumps(data))
+    hist("record", "--db", tmp_path / "h.sqlite", "--export", "", p, check=0)
