@@ -24,6 +24,8 @@ def main(argv=None) -> int:
     ap.add_argument("--noise", type=float, default=0.03, help="relative sd of the run-level drift (half of it per repetition)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--template", default=TEMPLATE)
+    ap.add_argument("--step", type=float, default=0.0,
+                    help="instead: a step of this size at the middle run of every series, and count how many are found there (+-1)")
     a = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         db = store.connect(os.path.join(tmp, "h.sqlite"))
@@ -32,12 +34,20 @@ def main(argv=None) -> int:
         while per_machine is None or machines * per_machine < a.series:
             host = f"noise-{machines}"
             for p in synthetic.write_history(a.template, os.path.join(tmp, host), a.runs, a.noise, a.seed + machines,
-                                             host=host):
+                                             host=host, step_at=a.runs // 2 if a.step else None, step=a.step,
+                                             stepped=lambda name: True):
                 importer.insert(db, importer.parse(p))
             machines += 1
             per_machine = len(changes.series(db)) // machines
         keys = sorted(changes.series(db).keys())[: a.series]
         found = changes.find(db)
+        if a.step:
+            near = {(c.benchmark, c.machine_id, c.preset) for c in found if abs(c.index - a.runs // 2) <= 1}
+            other = {(c.benchmark, c.machine_id, c.preset) for c in found if abs(c.index - a.runs // 2) > 1}
+            print(f"detected: {sum(k in near for k in keys)} of {len(keys)} series with a {a.step:+.0%} step at run "
+                  f"{a.runs // 2} of {a.runs} (+-1); {sum(k in other for k in keys)} with a change point elsewhere; "
+                  f"noise {a.noise:.0%} run-level + {a.noise / 2:.1%} per repetition")
+            return 0
         hit = {(c.benchmark, c.machine_id, c.preset) for c in found}
         fp = sum(k in hit for k in keys)
     rate = fp / len(keys)
