@@ -121,9 +121,36 @@ def run(repo: str, rev_range: str, scratch: str, json_dir: str, db: str | None, 
     return 0
 
 
+def import_git(repo: str, paths: list[str], db: str, export_dir: str | None, machine: str | None) -> int:
+    """Records every committed version of bench JSON files (results/ is overwritten run after run,
+    but git kept each version): oldest first; a version already recorded is skipped."""
+    import tempfile
+
+    from . import importer
+    n = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in paths:
+            rel = os.path.relpath(os.path.abspath(path), repo)
+            for sha in reversed(_git(repo, "log", "--format=%H", "--", rel).split()):
+                body = subprocess.run(["git", "-C", repo, "show", f"{sha}:{rel}"], capture_output=True).stdout
+                out = os.path.join(tmp, os.path.basename(rel))
+                with open(out, "wb") as f:
+                    f.write(body)
+                try:
+                    run = importer.record_file(db, out, machine=machine, export_dir=export_dir)
+                except importer.RecordError as e:
+                    print(f"{rel}@{sha[:12]}: skipped: {e}")
+                    continue
+                n += 1
+                print(f"{rel}@{sha[:12]}: recorded (measured at {run['commit'][:12]}, {len(run['results'])} rows)")
+    return n
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="pathbench history backfill", description=__doc__.split("\n\n")[0])
-    ap.add_argument("range", help="git revision range, e.g. HEAD~45..HEAD")
+    ap.add_argument("range", nargs="?", help="git revision range, e.g. HEAD~45..HEAD")
+    ap.add_argument("--git-results", nargs="+", metavar="JSON",
+                    help="instead of building: record every committed version of these bench JSON files (needs --db)")
     ap.add_argument("--repo", default=".", help="git repository to take the commits from")
     ap.add_argument("--scratch", default="/tmp/pathbench-backfill", help="scratch clone (kept for incremental builds)")
     ap.add_argument("--json-dir", default="/tmp/pathbench-backfill-json", help="where each commit's JSON goes")
@@ -133,6 +160,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--export", help="text export folder for recorded runs (with --db)")
     ap.add_argument("--log", help="append progress here too")
     a = ap.parse_args(argv)
+    if a.git_results:
+        if not a.db:
+            print("backfill: --git-results needs --db", file=sys.stderr)
+            return 2
+        import_git(os.path.abspath(a.repo), a.git_results, a.db, a.export, a.machine)
+        return 0
+    if not a.range:
+        print("backfill: give a revision range (or --git-results)", file=sys.stderr)
+        return 2
     return run(os.path.abspath(a.repo), a.range, os.path.abspath(a.scratch), os.path.abspath(a.json_dir),
                a.db, a.wall, a.machine, a.log, a.export)
 

@@ -102,26 +102,26 @@
     }
   }
 
+  // One row per benchmark: its series on every machine side by side, CPU before GPU, so a CPU and
+  // a GPU run of the same render (or two machines) can be read against each other.
   function plots() {
     const root = document.getElementById("plots");
     const groups = new Map();
     for (const s of data.series) {
-      const key = s.machine + " " + s.machine_id.slice(0, 6) + (s.preset ? " · preset " + s.preset : "") + "\u0000" + s.group;
-      if (!groups.has(key)) groups.set(key, []);
-      groups.get(key).push(s);
+      if (!groups.has(s.group)) groups.set(s.group, []);
+      groups.get(s.group).push(s);
     }
-    let machine = null;
-    for (const [key, list] of groups) {
-      const [m, group] = key.split("\u0000");
-      if (m !== machine) { text(el("h2", {}, root), "Machine " + m); machine = m; }
+    for (const [group, list] of groups) {
       const row = el("div", { class: "row" }, root);
-      text(el("h3", {}, row), group.replace("{device}", list.map((s) => s.device).filter(Boolean).join(" | ") || "-"));
-      list.sort((a, b) => (a.device < b.device ? -1 : 1));  // cpu left of gpu
+      const devices = [...new Set(list.map((s) => s.device).filter(Boolean))].join(" | ");
+      text(el("h3", {}, row), group.replace("{device}", devices || "-"));
+      list.sort((a, b) => (a.device + a.machine + a.preset < b.device + b.machine + b.preset ? -1 : 1));
       for (const s of list) {
         const panel = el("div", { class: "panel", id: s.id }, row);
         const cap = el("p", { class: "caption" }, panel);
-        text(cap, `${s.device || ""} ${s.machine_id} · ${s.points.length} runs · latest ${fmt(s.latest)} ${s.unit} ` +
-          `(${pct(s.latest_vs_baseline)} vs first) `);
+        text(el("b", {}, cap), `${s.device ? s.device.toUpperCase() + " · " : ""}${s.machine} ${s.machine_id.slice(0, 6)}`);
+        text(cap, `${s.preset ? " · preset " + s.preset : ""} · ${s.points.length} runs · latest ${fmt(s.latest)} ` +
+          `${s.unit} (${pct(s.latest_vs_baseline)} vs first)`);
         for (const c of s.changes) {
           text(cap, ` · change ${pct(c.change)} p=${c.p_value.toExponential(1)} at `);
           commitNode(c.commit, cap);

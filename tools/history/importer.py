@@ -146,8 +146,9 @@ def parse(path: str, commit: str | None = None, date: str | None = None, machine
     else:
         raise RecordError(f"{path}: neither a bench JSON (context + benchmarks) nor a render report")
     commit = commit or context.get("git_revision")
-    if not commit or not isinstance(commit, str):
+    if not commit or not isinstance(commit, str) or not commit.split():
         raise RecordError(f"{path}: no git revision in the JSON; pass --commit")
+    commit = commit.split()[0]  # some runs annotate it ("638947392d8c (PATHBENCH_SOURCE_COMMIT; ...)")
     run_date = date or context.get("date") or context.get("date_utc")
     if not run_date and kind == "render":  # render reports carry no date yet: the file's own time
         run_date = dt.datetime.fromtimestamp(os.path.getmtime(path), dt.timezone.utc).isoformat()

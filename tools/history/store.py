@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import sqlite3
 
 SCHEMA_VERSION = 1
@@ -91,6 +92,8 @@ def machine_id(context: dict) -> str:
 
 
 def connect(path: str, create: bool = True) -> sqlite3.Connection:
+    if create and os.path.dirname(path):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
     db = sqlite3.connect(path, isolation_level=None)  # transactions explicit (BEGIN/COMMIT)
     db.execute("PRAGMA foreign_keys = ON")
     has_meta = db.execute("SELECT 1 FROM sqlite_master WHERE type='table' AND name='meta'").fetchone()
