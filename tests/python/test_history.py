@@ -227,3 +227,51 @@ def test_instruction_count_preset_is_a_bench_json_history_records(tmp_path):
     p = tmp_path / "instr.json"
     p.write_text(json.dumps(data))
     hist("record", "--db", tmp_path / "h.sqlite", "--export", "", p, check=0)
+
+
+def _git_repo(path):
+    env = os.environ | {"GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@t", "GIT_COMMITTER_NAME": "t",
+                        "GIT_COMMITTER_EMAIL": "t@t"}
+    path.mkdir()
+    subprocess.run(["git", "init", "-q", path], check=True)
+
+    def commit(files: dict, msg: str):
+        for name, body in files.items():
+            (path / name).write_text(body)
+        subprocess.run(["git", "-C", path, "add", "-A"], check=True)
+        subprocess.run(["git", "-C", path, "commit", "-qm", msg], check=True, env=env)
+    return commit
+
+
+def test_backfill_git_results_records_every_committed_version(tmp_path):
+    commit = _git_repo(tmp_path / "repo")
+    paths = synthetic.write_history(QUICK, tmp_path / "json", 3, 0.02, seed=4)
+    for i, p in enumerate(paths):
+        commit({"bench-quick.json": Path(p).read_text()}, f"results {i}")
+    db = tmp_path / "h.sqlite"
+    r = hist("backfill", "--repo", tmp_path / "repo", "--db", db, "--export", "", "--git-results",
+             tmp_path / "repo" / "bench-quick.json", check=0)
+    assert r.stdout.count("recorded") == 3
+    assert rows(db, "SELECT commit_sha FROM runs ORDER BY id") == [(synthetic.fake_commit(i, "synthetic-host"),)
+                                                                   for i in range(3)]
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None or shutil.which("ninja") is None, reason="needs cmake and ninja")
+def test_backfill_goes_on_past_commits_that_do_not_build_or_measure(tmp_path):
+    """Two commits: one whose CMakeLists is broken, one that 'builds' a pathbench that is not one.
+    Both are reported as failed and the backfill finishes (exit 0)."""
+    commit = _git_repo(tmp_path / "repo")
+    commit({"CMakeLists.txt": "this is not cmake(\n"}, "broken")
+    commit({"CMakeLists.txt": "cmake_minimum_required(VERSION 3.20)\nproject(fake NONE)\n"
+            "add_custom_target(pathbench ALL COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/bin\n"
+            "  COMMAND ${CMAKE_COMMAND} -E copy ${CMAKE_SOURCE_DIR}/fake.sh ${CMAKE_BINARY_DIR}/bin/pathbench)\n",
+            "fake.sh": "#!/bin/sh\necho not pathbench\n"}, "fake")
+    os.chmod(tmp_path / "repo" / "fake.sh", 0o755)
+    subprocess.run(["git", "-C", tmp_path / "repo", "update-index", "--chmod=+x", "fake.sh"], check=True)
+    r = hist("backfill", "--repo", tmp_path / "repo", "--scratch", tmp_path / "scratch", "--json-dir",
+             tmp_path / "out", "--wall", "0", "HEAD", check=0)
+    assert "build failed" in r.stdout
+    assert "measuring failed" in r.stdout or "build failed" in r.stdout.split("[2/2]")[1]
+    assert "0 of 2 commits measured, 2 failed" in r.stdout
+    r = hist("backfill", "--repo", tmp_path / "repo", "--scratch", tmp_path / "scratch", "no-such-rev..HEAD", check=2)
+    assert "not a revision range" in r.stderr

@@ -56,7 +56,11 @@ def build(scratch: str, build_dir: str, log) -> bool:
 
 def run(repo: str, rev_range: str, scratch: str, json_dir: str, db: str | None, wall: int,
         machine: str | None, log_path: str | None, export_dir: str | None = None) -> int:
-    revs = _git(repo, "rev-list", "--reverse", "--first-parent", rev_range).split()
+    try:
+        revs = _git(repo, "rev-list", "--reverse", "--first-parent", rev_range).split()
+    except subprocess.CalledProcessError as e:
+        print(f"backfill: {rev_range}: not a revision range in {repo}: {e.stderr.strip()}", file=sys.stderr)
+        return 2
     if not revs:
         print(f"backfill: {rev_range}: no commits in this range", file=sys.stderr)
         return 2
