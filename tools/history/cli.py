@@ -11,7 +11,6 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_DB = os.path.join(ROOT, "results", "history", "history.sqlite")
-DEFAULT_EXPORT = os.path.join(ROOT, "results", "history", "runs")
 
 
 def _err(msg: str) -> int:
@@ -59,7 +58,7 @@ def cmd_record(a) -> int:
 
 def cmd_rebuild(a) -> int:
     from . import export
-    if not os.path.isdir(a.export):
+    if not a.export or not os.path.isdir(a.export):
         return _err(f"{a.export}: no such folder")
     try:
         n = export.rebuild(a.export, a.db)
@@ -127,11 +126,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--commit", help="git commit (default: the JSON's git_revision)")
     p.add_argument("--date", help="ISO-8601 date of the run (default: the JSON's)")
     p.add_argument("--machine", help="a name for the machine (its identity stays the fingerprint hash)")
-    p.add_argument("--export", default=DEFAULT_EXPORT, help="folder for the text export ('' for none)")
+    p.add_argument("--export", help="folder for the text export (default: runs/ beside the database; '' for none)")
     p.set_defaults(fn=cmd_record)
 
     p = with_db(sub.add_parser("rebuild", help="make the database again from the text export"))
-    p.add_argument("--export", default=DEFAULT_EXPORT, help="folder of run files")
+    p.add_argument("--export", help="folder of run files (default: runs/ beside the database)")
     p.set_defaults(fn=cmd_rebuild)
 
     from .changes import DEFAULT_MAX_PVALUE, DEFAULT_MIN_CHANGE
@@ -166,6 +165,10 @@ def main(argv: list[str] | None = None) -> int:
         return instructions.main(rest)
     if rest:
         return _err(f"unrecognised arguments: {' '.join(rest)}")
-    if getattr(args, "export", None) == "":
-        args.export = None
+    if hasattr(args, "export"):
+        # The text export lives beside its database: results/history/{history.sqlite,runs/} by default.
+        if args.export is None:
+            args.export = os.path.join(os.path.dirname(os.path.abspath(args.db)), "runs")
+        elif args.export == "":
+            args.export = None
     return args.fn(args)
