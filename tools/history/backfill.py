@@ -108,6 +108,7 @@ def run(repo: str, rev_range: str, scratch: str, json_dir: str, db: str | None, 
                 data = json.load(f)
             os.remove(out + ".raw")
         data["context"].update({"git_revision": rev, "commit_date": date, "binary_sha256": h,
+                                "commit_seq": int(_git(repo, "rev-list", "--count", rev)),
                                 "backfill": True, "commit_subject": subject})
         with open(out, "w") as f:
             json.dump(data, f, indent=1, allow_nan=False)

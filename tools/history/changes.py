@@ -57,7 +57,7 @@ def series(db, benchmark: str | None = None, machine: str | None = None) -> dict
         "SELECT r.benchmark, u.machine_id, COALESCE(u.preset, ''), u.id, u.commit_sha, COALESCE(u.commit_date, u.run_date), r.value "
         "FROM results r JOIN runs u ON u.id = r.run_id JOIN machines m ON m.id = u.machine_id "
         "WHERE r.value IS NOT NULL AND (? IS NULL OR m.name = ? OR m.id LIKE ? || '%') "
-        "ORDER BY COALESCE(u.commit_date, u.run_date), u.run_date, u.id, r.repetition",
+        "ORDER BY COALESCE(u.commit_date, u.run_date), u.commit_seq, u.run_date, u.id, r.repetition",
         (machine, machine, machine)).fetchall()
     pattern = re.compile(benchmark) if benchmark else None
     out: dict[tuple[str, str], list[Point]] = {}

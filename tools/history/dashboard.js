@@ -4,7 +4,7 @@
 (function () {
   const data = JSON.parse(document.getElementById("history-data").textContent);
   const NS = "http://www.w3.org/2000/svg";
-  const W = 560, H = 230, M = { l: 64, r: 12, t: 14, b: 58 };
+  const W = 560, H = 230, M = { l: 64, r: 36, t: 14, b: 58 };
 
   function el(tag, attrs, parent, ns) {
     const e = ns ? document.createElementNS(NS, tag) : document.createElement(tag);
@@ -14,13 +14,14 @@
   }
   function svg(tag, attrs, parent) { return el(tag, attrs, parent, true); }
   function text(parent, s) { parent.appendChild(document.createTextNode(s)); return parent; }
-  function fmt(v) {
+  // digits: significant digits, more when an axis spans a narrow range (ticks must differ).
+  function fmt(v, digits) {
     if (v === null || v === undefined) return "–";
-    const a = Math.abs(v);
-    if (a >= 1e6) return (v / 1e6).toFixed(2) + "M";
-    if (a >= 1e4) return (v / 1e3).toFixed(1) + "k";
-    if (a >= 100) return v.toFixed(0);
-    return v.toPrecision(3);
+    const a = Math.abs(v), d = digits || 4;
+    if (a >= 1e9) return (v / 1e9).toPrecision(d) + "G";
+    if (a >= 1e6) return (v / 1e6).toPrecision(d) + "M";
+    if (a >= 1e4) return (v / 1e3).toPrecision(d) + "k";
+    return String(Number(v.toPrecision(d)));  // 9050, not 9.05e+3
   }
   function pct(v) { return v === null || v === undefined ? "–" : (v >= 0 ? "+" : "") + (100 * v).toFixed(2) + "%"; }
   function commitNode(sha, parent) {
@@ -51,7 +52,8 @@
     for (let k = 0; k <= 4; k++) {
       const v = lo + (k / 4) * (hi - lo);
       svg("line", { x1: M.l, x2: W - M.r, y1: y(v), y2: y(v), class: "grid" }, s);
-      text(svg("text", { x: M.l - 4, y: y(v) + 3, class: "ytick" }, s), fmt(v));
+      const digits = Math.min(8, Math.max(3, Math.ceil(Math.log10(Math.abs(hi) / (hi - lo))) + 2));
+      text(svg("text", { x: M.l - 4, y: y(v) + 3, class: "ytick" }, s), fmt(v, digits));
     }
     const unit = metric === "rays" ? "rays/s" : series.unit;
     text(svg("text", { x: 12, y: M.t + (H - M.t - M.b) / 2, class: "ylabel",
@@ -114,7 +116,7 @@
     for (const [group, list] of groups) {
       const row = el("div", { class: "row" }, root);
       const devices = [...new Set(list.map((s) => s.device).filter(Boolean))].join(" | ");
-      text(el("h3", {}, row), group.replace("{device}", devices || "-"));
+      text(el("h3", {}, row), group.replace("{device}", devices.includes("|") ? "[" + devices + "]" : devices || "-"));
       list.sort((a, b) => (a.device + a.machine + a.preset < b.device + b.machine + b.preset ? -1 : 1));
       for (const s of list) {
         const panel = el("div", { class: "panel", id: s.id }, row);

@@ -12,7 +12,7 @@ import os
 
 from . import store
 
-HEADER_KEYS = ("run_key", "kind", "commit", "commit_date", "run_date", "machine_id", "machine_name",
+HEADER_KEYS = ("run_key", "kind", "commit", "commit_date", "commit_seq", "run_date", "machine_id", "machine_name",
                "machine_description", "preset", "film_hash", "source", "context")
 
 
@@ -24,7 +24,7 @@ def file_name(run: dict) -> str:
 def write_run(folder: str, run: dict, pending: bool = False) -> str:
     os.makedirs(folder, exist_ok=True)
     path = os.path.join(folder, file_name(run)) + (".pending" if pending else "")
-    lines = [store.canonical({"run": {k: run[k] for k in HEADER_KEYS}})]
+    lines = [store.canonical({"run": {k: run.get(k) for k in HEADER_KEYS}})]
     for r in sorted(run["results"], key=lambda r: (r["benchmark"], r["repetition"])):
         lines.append(store.canonical(r))
     with open(path, "w") as f:

@@ -67,6 +67,16 @@ def _commit_date(commit: str, repo: str | None) -> str | None:
     return _iso(r.stdout.strip(), "commit date") if r.returncode == 0 and r.stdout.strip() else None
 
 
+def _commit_seq(commit: str, repo: str | None) -> int | None:
+    """How many commits lead to this one: orders commits that share a committer date (a rebase)."""
+    try:
+        r = subprocess.run(["git", "-C", repo or ".", "rev-list", "--count", commit + "^{commit}"],
+                           capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return int(r.stdout) if r.returncode == 0 and r.stdout.strip().isdigit() else None
+
+
 def _full_sha(commit: str, repo: str | None) -> str:
     """A short or symbolic revision made the full hash where git knows it; kept as given otherwise."""
     try:
@@ -157,6 +167,7 @@ def parse(path: str, commit: str | None = None, date: str | None = None, machine
     run_date = _iso(run_date, f"{path}: date" if not date else "--date")
     commit = _full_sha(commit, repo)
     commit_date = context.get("commit_date") or _commit_date(commit, repo)
+    commit_seq = context.get("commit_seq") or _commit_seq(commit, repo)
     try:
         desc = store.machine_description(context)
     except ValueError as e:
@@ -168,6 +179,7 @@ def parse(path: str, commit: str | None = None, date: str | None = None, machine
     return {
         "run_key": hashlib.sha256(store.canonical(data).encode()).hexdigest(),
         "kind": kind, "commit": commit, "commit_date": commit_date and _iso(commit_date, "commit date"),
+        "commit_seq": commit_seq,
         "run_date": run_date, "machine_id": mid, "machine_name": name, "machine_description": desc,
         "preset": context.get("pathbench_preset"), "film_hash": film_hash,
         "source": os.path.basename(path), "context": context, "results": results,
@@ -184,9 +196,10 @@ def insert(db, run: dict) -> int:
         db.execute("INSERT OR IGNORE INTO machines VALUES (?, ?, ?)",
                    (run["machine_id"], run["machine_name"], store.canonical(run["machine_description"])))
         cur = db.execute(
-            "INSERT INTO runs (run_key, kind, commit_sha, commit_date, run_date, machine_id, preset, film_hash, "
-            "source, context) VALUES (?,?,?,?,?,?,?,?,?,?)",
-            (run["run_key"], run["kind"], run["commit"], run["commit_date"], run["run_date"], run["machine_id"],
+            "INSERT INTO runs (run_key, kind, commit_sha, commit_date, commit_seq, run_date, machine_id, preset, "
+            "film_hash, source, context) VALUES (?,?,?,?,?,?,?,?,?,?,?)",
+            (run["run_key"], run["kind"], run["commit"], run["commit_date"], run.get("commit_seq"), run["run_date"],
+             run["machine_id"],
              run["preset"], run["film_hash"], run["source"], store.canonical(run["context"])))
         rid = cur.lastrowid
         db.executemany(

@@ -27,7 +27,8 @@ CREATE TABLE runs (
   run_key TEXT NOT NULL UNIQUE,    -- sha256 of the run's canonical JSON: the same run twice is refused
   kind TEXT NOT NULL,              -- 'bench' (Google Benchmark JSON) or 'render' (pathbench render report)
   commit_sha TEXT NOT NULL,
-  commit_date TEXT,                -- ISO-8601; orders the series
+  commit_date TEXT,                -- ISO-8601 committer date; orders the series ...
+  commit_seq INTEGER,              -- ... then this: commits reachable from it (rebased commits share a date)
   run_date TEXT NOT NULL,          -- ISO-8601, when it ran
   machine_id TEXT NOT NULL REFERENCES machines(id),
   preset TEXT,                     -- context.pathbench_preset where given
