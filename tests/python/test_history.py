@@ -275,3 +275,27 @@ def test_backfill_goes_on_past_commits_that_do_not_build_or_measure(tmp_path):
     assert "0 of 2 commits measured, 2 failed" in r.stdout
     r = hist("backfill", "--repo", tmp_path / "repo", "--scratch", tmp_path / "scratch", "no-such-rev..HEAD", check=2)
     assert "not a revision range" in r.stderr
+
+
+def test_instruction_counts_report_every_exact_step(tmp_path):
+    """Noise-free counts: a staircase of consecutive improvements is reported step by step (Otava
+    would merge it), a 0.2% wobble is not, and the newest run after a +3% step fails the gate."""
+    values = [5000.0] * 5 + [4300.0, 4000.0, 3900.0] + [3890.0] * 5 + [3900.0] * 3 + [4017.0] * 2
+    paths = []
+    for i, v in enumerate(values):
+        data = {"context": {"host_name": "h", "cpu_model": "c", "num_cpus": 2, "git_revision": f"{i:040x}",
+                            "date": f"2026-01-01T00:{i:02d}:00Z", "pathbench_preset": "instructions"},
+                "benchmarks": [{"name": "callgrind/x/instructions", "run_type": "iteration", "repetition_index": 0,
+                                "real_time": v, "cpu_time": v, "time_unit": "instructions", "iterations": 1}]}
+        paths.append(tmp_path / f"{i}.json")
+        paths[-1].write_text(json.dumps(data))
+    db = tmp_path / "h.sqlite"
+    hist("record", "--db", db, "--export", "", *paths, check=0)
+    r = hist("changes", "--db", db, "--json", "--fail-on-regression", check=1)
+    found = json.loads(r.stdout)
+    assert [(c["commit"], round(c["change"], 3), c["method"], c["p_value"]) for c in found] == [
+        (f"{5:040x}", -0.14, "exact", None), (f"{6:040x}", -0.07, "exact", None),
+        (f"{7:040x}", -0.025, "exact", None), (f"{16:040x}", 0.03, "exact", None)]
+    assert "regression: callgrind/x/instructions" in r.stderr
+    otava = json.loads(hist("changes", "--db", db, "--json", "--otava-only", check=0).stdout)
+    assert otava and all(c["method"] == "otava" for c in otava)

@@ -4,6 +4,12 @@ Student t-test merge, Fleming et al. 2023, as MongoDB's performance CI uses it).
 
 A series is one point per recorded run, ordered by commit date: the median of the run's
 repetitions of the benchmark's value (real time, or instructions per sample), lower is better.
+Instruction counts (unit "instructions", callgrind) have no noise: a run repeated gives the same
+count, so Otava's tests have nothing to weigh (segments of one run each give no variance and a
+staircase of consecutive improvements merges into one step). For those series every step between
+consecutive runs larger than min_change is reported as it is (`method` "exact", `p_value` null);
+`exact=False` (CLI --otava-only) sends them through Otava too.
+
 A change point is reported with the first run after it (`commit`) and the last one before it
 (`previous_commit`); `change` is mean after / mean before - 1 (+ is slower), `p_value` Otava's
 t-test between the two segments. Points with p >= max_pvalue or |change| <= min_change are merged
@@ -44,10 +50,11 @@ class Change:
     previous_commit: str
     index: int
     change: float
-    p_value: float
+    p_value: float | None
     mean_before: float
     mean_after: float
     regression: bool
+    method: str = "otava"
 
 
 def series(db, benchmark: str | None = None, machine: str | None = None) -> dict[tuple[str, str, str], list[Point]]:
@@ -84,16 +91,28 @@ def detect(values: list[float], max_pvalue: float = DEFAULT_MAX_PVALUE, min_chan
     return [(int(c.index), float(c.stats.forward_rel_change()), float(c.stats.pvalue)) for c in cps]
 
 
-def find(db, benchmark=None, machine=None, max_pvalue=DEFAULT_MAX_PVALUE, min_change=DEFAULT_MIN_CHANGE) -> list[Change]:
+def exact_steps(values: list[float], min_change: float = DEFAULT_MIN_CHANGE):
+    """[(index, relative change, None)] wherever a noise-free value moves by more than min_change."""
+    return [(i, values[i] / values[i - 1] - 1, None) for i in range(1, len(values))
+            if values[i - 1] and abs(values[i] / values[i - 1] - 1) > min_change]
+
+
+def find(db, benchmark=None, machine=None, max_pvalue=DEFAULT_MAX_PVALUE, min_change=DEFAULT_MIN_CHANGE,
+         exact: bool = True) -> list[Change]:
     names = dict(db.execute("SELECT id, name FROM machines").fetchall())
+    units = dict(db.execute("SELECT benchmark, MAX(unit) FROM results GROUP BY benchmark").fetchall())
     found = []
     for (bench, mid, preset), pts in sorted(series(db, benchmark, machine).items()):
         medians = [p.median for p in pts]
-        for idx, change, p in detect(medians, max_pvalue, min_change):
-            before = medians[:idx]
-            after = medians[idx:]
+        deterministic = exact and units.get(bench) == "instructions"
+        steps = exact_steps(medians, min_change) if deterministic else detect(medians, max_pvalue, min_change)
+        bounds = [0] + [i for i, _, _ in steps] + [len(medians)]
+        for k, (idx, change, p) in enumerate(steps):
+            # Means of the segments on either side (between neighbouring change points).
+            before, after = medians[bounds[k]:idx], medians[idx:bounds[k + 2]]
             found.append(Change(bench, names[mid], mid, preset, pts[idx].commit, pts[idx - 1].commit, idx, change, p,
-                                statistics.fmean(before), statistics.fmean(after), change > 0))
+                                statistics.fmean(before), statistics.fmean(after), change > 0,
+                                "exact" if deterministic else "otava"))
     return found
 
 
@@ -116,6 +135,7 @@ def format_table(changes: list[Change]) -> str:
         return "no change points"
     lines = [f"{'change':>8}  {'p':>8}  {'commit':12}  {'previous':12}  machine  benchmark"]
     for c in changes:
-        lines.append(f"{c.change * 100:+7.2f}%  {c.p_value:8.1e}  {c.commit[:12]:12}  {c.previous_commit[:12]:12}  "
+        p = "exact" if c.p_value is None else f"{c.p_value:8.1e}"
+        lines.append(f"{c.change * 100:+7.2f}%  {p:>8}  {c.commit[:12]:12}  {c.previous_commit[:12]:12}  "
                      f"{c.machine}  {c.benchmark}")
     return "\n".join(lines)

@@ -82,7 +82,7 @@ def cmd_changes(a) -> int:
     from . import store
     try:
         db = _open(a.db)
-        found = changes.find(db, a.benchmark, a.machine, a.max_pvalue, a.min_change)
+        found = changes.find(db, a.benchmark, a.machine, a.max_pvalue, a.min_change, exact=not a.otava_only)
     except (FileNotFoundError, store.SchemaError) as e:
         return _err(str(e))
     except re.error as e:
@@ -91,8 +91,9 @@ def cmd_changes(a) -> int:
     if a.fail_on_regression:
         bad = changes.newest_after_regression(found)
         for c in bad:
-            print(f"regression: {c.benchmark} on {c.machine}: {c.change * 100:+.2f}% since {c.commit[:12]} "
-                  f"(p={c.p_value:.1e})", file=sys.stderr)
+            p = "exact" if c.p_value is None else f"p={c.p_value:.1e}"
+            print(f"regression: {c.benchmark} on {c.machine}: {c.change * 100:+.2f}% since {c.commit[:12]} ({p})",
+                  file=sys.stderr)
         return 1 if bad else 0
     return 0
 
@@ -141,6 +142,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--fail-on-regression", action="store_true", help="exit 1 when a newest run sits after a regression")
     p.add_argument("--max-pvalue", type=float, default=DEFAULT_MAX_PVALUE)
     p.add_argument("--min-change", type=float, default=DEFAULT_MIN_CHANGE, help="relative; smaller steps are merged away")
+    p.add_argument("--otava-only", action="store_true",
+                   help="Otava for instruction-count series too (default: their exact steps)")
     p.set_defaults(fn=cmd_changes)
 
     p = with_db(sub.add_parser("report", help="write the static HTML dashboard"))

@@ -125,7 +125,7 @@
         text(cap, `${s.preset ? " · preset " + s.preset : ""} · ${s.points.length} runs · latest ${fmt(s.latest)} ` +
           `${s.unit} (${pct(s.latest_vs_baseline)} vs first)`);
         for (const c of s.changes) {
-          text(cap, ` · change ${pct(c.change)} p=${c.p_value.toExponential(1)} at `);
+          text(cap, ` · change ${pct(c.change)} ${c.p_value === null ? "(exact)" : "p=" + c.p_value.toExponential(1)} at `);
           commitNode(c.commit, cap);
         }
         chart(s, "time", panel);
