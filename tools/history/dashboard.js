@@ -63,12 +63,14 @@
       text(svg("text", { x: x(i), y: H - M.b + 10, class: "xtick",
         transform: `rotate(55 ${x(i)} ${H - M.b + 10})` }, s), series.points[i].commit.slice(0, 7));
     }
-    for (const c of series.changes) {
+    series.changes.forEach((c, k) => {
       const cx = (x(c.index - 1) + x(c.index)) / 2;
       // For rays/s a slower run is a drop, so the colour follows the time change either way.
       svg("line", { x1: cx, x2: cx, y1: M.t, y2: H - M.b, class: "cp " + (c.change > 0 ? "slower" : "faster") }, s);
-      text(svg("text", { x: cx + 3, y: M.t + 9, class: "cplabel" }, s), `${c.commit.slice(0, 7)} ${pct(c.change)}`);
-    }
+      // Labels staggered over four lines so neighbouring change points stay readable.
+      text(svg("text", { x: cx + 3, y: M.t + 9 + (k % 4) * 10, class: "cplabel" }, s),
+        `${c.commit.slice(0, 7)} ${pct(c.change)}`);
+    });
     let d = "";
     meds.forEach((v, i) => { if (v !== null) d += (d ? " L" : "M") + x(i).toFixed(1) + " " + y(v).toFixed(1); });
     svg("path", { d: d, class: "median" }, s);
