@@ -5,16 +5,20 @@
 #include <algorithm>
 #include <exception>
 #include <string>
+#include <string_view>
 
 #include "accuracy_command.h"
 #include "bench_command.h"
 #include "compare_command.h"
+#include "history_command.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/output_file.h"
 #include "render_command.h"
 #include "reproduce_command.h"
 
 int main(int argc, char** argv) {
+  // `history` takes its own arguments (Python's argparse), so it is handed over before CLI11 parses.
+  if (argc >= 2 && std::string_view(argv[1]) == "history") return pb::app::run_history(argc - 2, argv + 2);
   CLI::App app{"pathbench: CPU/GPU path-tracing benchmark suite"};
   app.require_subcommand(1);
   pb::app::RenderOptions render;
@@ -30,6 +34,8 @@ int main(int argc, char** argv) {
   auto* accuracy_cmd = app.add_subcommand(
       "accuracy", "measure the speed/accuracy trade: error against a converged reference, per configuration and spp");
   pb::app::add_accuracy_options(*accuracy_cmd, accuracy);
+  // Listed for --help only: main() hands `history` over to tools/history before parsing.
+  app.add_subcommand("history", "performance history: record runs, change points, dashboard, backfill (tools/history)");
   pb::app::CompareOptions compare;
   auto* compare_cmd = app.add_subcommand("compare", "judge two benchmark JSON files for regressions (Mann-Whitney U)");
   pb::app::add_compare_options(*compare_cmd, compare);

@@ -12,7 +12,8 @@ apt_pkgs=(build-essential cmake ninja-build ccache pkg-config git python3 python
           libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev
           python3-dev  # the `pathbench` Python module (python/; pybind11 from PyPI: tools/requirements.txt)
           libllvm19  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison
-          clang libfuzzer-14-dev)  # the fuzz targets (scripts/fuzz.sh): libFuzzer + ASan + UBSan
+          clang libfuzzer-14-dev  # the fuzz targets (scripts/fuzz.sh): libFuzzer + ASan + UBSan
+          valgrind chromium)  # history: instruction counts; the dashboard's headless-browser test
 missing=()
 for p in "${apt_pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -33,12 +34,16 @@ if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
     python3 -m venv "$root/.venv"
   fi
   req="$root/tools/requirements.txt"
+  # Installed without their declared dependencies (see the file's header): apache-otava pins
+  # numpy/scipy and pulls cloud clients that its change-point code does not use.
+  nodeps="$root/tools/requirements-nodeps.txt"
   stamp="$root/.venv/.requirements.sha"
-  sum=$(sha256sum "$req" | cut -d' ' -f1)
+  sum=$(cat "$req" "$nodeps" | sha256sum | cut -d' ' -f1)
   if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$sum" ]; then
     echo "[install-deps] pip install -r tools/requirements.txt"
     "$root/.venv/bin/python" -m pip install -q --upgrade pip
     "$root/.venv/bin/python" -m pip install -q -r "$req"
+    "$root/.venv/bin/python" -m pip install -q --no-deps -r "$nodeps"
     echo "$sum" > "$stamp"
   else
     echo "[install-deps] .venv: up to date"

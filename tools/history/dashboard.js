@@ -1,0 +1,142 @@
+// pathbench history dashboard: draws every series of the inline JSON (report.py) as SVG.
+// Written by hand, no library: the page must work offline and from file:// (CI's headless chromium).
+"use strict";
+(function () {
+  const data = JSON.parse(document.getElementById("history-data").textContent);
+  const NS = "http://www.w3.org/2000/svg";
+  const W = 560, H = 230, M = { l: 64, r: 36, t: 14, b: 58 };
+
+  function el(tag, attrs, parent, ns) {
+    const e = ns ? document.createElementNS(NS, tag) : document.createElement(tag);
+    for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+    if (parent) parent.appendChild(e);
+    return e;
+  }
+  function svg(tag, attrs, parent) { return el(tag, attrs, parent, true); }
+  function text(parent, s) { parent.appendChild(document.createTextNode(s)); return parent; }
+  // digits: significant digits, more when an axis spans a narrow range (ticks must differ).
+  function fmt(v, digits) {
+    if (v === null || v === undefined) return "–";
+    const a = Math.abs(v), d = digits || 4;
+    if (a >= 1e9) return (v / 1e9).toPrecision(d) + "G";
+    if (a >= 1e6) return (v / 1e6).toPrecision(d) + "M";
+    if (a >= 1e4) return (v / 1e3).toPrecision(d) + "k";
+    return String(Number(v.toPrecision(d)));  // 9050, not 9.05e+3
+  }
+  function pct(v) { return v === null || v === undefined ? "–" : (v >= 0 ? "+" : "") + (100 * v).toFixed(2) + "%"; }
+  function commitNode(sha, parent) {
+    const short = sha.slice(0, 10);
+    if (window.COMMIT_URL) return text(el("a", { href: window.COMMIT_URL.replace("{}", sha) }, parent), short);
+    return text(el("code", { title: sha }, parent), short);
+  }
+  function median(xs) {
+    const s = xs.slice().sort((a, b) => a - b), n = s.length;
+    return n % 2 ? s[(n - 1) / 2] : (s[n / 2 - 1] + s[n / 2]) / 2;
+  }
+
+  // One chart: x = runs in commit order, y = each repetition (dots) and the run's median (line).
+  function chart(series, metric, parent) {
+    const pts = series.points.map((p) => (metric === "rays" ? p.rays : p.values));
+    const meds = pts.map((v) => (v.length ? median(v) : null));
+    const all = pts.flat();
+    let lo = Math.min(...all), hi = Math.max(...all);
+    if (lo === hi) { lo -= Math.abs(lo) * 0.01 || 1; hi += Math.abs(hi) * 0.01 || 1; }
+    const pad = (hi - lo) * 0.08; lo -= pad; hi += pad;
+    const n = pts.length;
+    const x = (i) => M.l + (n === 1 ? 0.5 : i / (n - 1)) * (W - M.l - M.r);
+    const y = (v) => M.t + (1 - (v - lo) / (hi - lo)) * (H - M.t - M.b);
+    const s = svg("svg", { width: W, height: H, viewBox: `0 0 ${W} ${H}`, class: "chart", "data-metric": metric });
+    parent.appendChild(s);
+    svg("line", { x1: M.l, y1: M.t, x2: M.l, y2: H - M.b, class: "axis" }, s);
+    svg("line", { x1: M.l, y1: H - M.b, x2: W - M.r, y2: H - M.b, class: "axis" }, s);
+    for (let k = 0; k <= 4; k++) {
+      const v = lo + (k / 4) * (hi - lo);
+      svg("line", { x1: M.l, x2: W - M.r, y1: y(v), y2: y(v), class: "grid" }, s);
+      const digits = Math.min(8, Math.max(3, Math.ceil(Math.log10(Math.abs(hi) / (hi - lo))) + 2));
+      text(svg("text", { x: M.l - 4, y: y(v) + 3, class: "ytick" }, s), fmt(v, digits));
+    }
+    const unit = metric === "rays" ? "rays/s" : series.unit;
+    text(svg("text", { x: 12, y: M.t + (H - M.t - M.b) / 2, class: "ylabel",
+      transform: `rotate(-90 12 ${M.t + (H - M.t - M.b) / 2})` }, s), unit);
+    const step = Math.max(1, Math.ceil(n / 16));
+    for (let i = 0; i < n; i += step) {
+      text(svg("text", { x: x(i), y: H - M.b + 10, class: "xtick",
+        transform: `rotate(55 ${x(i)} ${H - M.b + 10})` }, s), series.points[i].commit.slice(0, 7));
+    }
+    series.changes.forEach((c, k) => {
+      const cx = (x(c.index - 1) + x(c.index)) / 2;
+      // For rays/s a slower run is a drop, so the colour follows the time change either way.
+      svg("line", { x1: cx, x2: cx, y1: M.t, y2: H - M.b, class: "cp " + (c.change > 0 ? "slower" : "faster") }, s);
+      // Labels staggered over four lines so neighbouring change points stay readable.
+      text(svg("text", { x: cx + 3, y: M.t + 9 + (k % 4) * 10, class: "cplabel" }, s),
+        `${c.commit.slice(0, 7)} ${pct(c.change)}`);
+    });
+    let d = "";
+    meds.forEach((v, i) => { if (v !== null) d += (d ? " L" : "M") + x(i).toFixed(1) + " " + y(v).toFixed(1); });
+    svg("path", { d: d, class: "median" }, s);
+    pts.forEach((vals, i) => {
+      const p = series.points[i];
+      for (const v of vals) {
+        const c = svg("circle", { cx: x(i), cy: y(v), r: 2.2, class: "rep" }, s);
+        text(svg("title", {}, c), `${p.commit.slice(0, 12)} ${p.date}\n${p.subject}\n${fmt(v)} ${unit}`);
+      }
+    });
+    return s;
+  }
+
+  function summary() {
+    const t = document.getElementById("summary");
+    const head = el("tr", {}, t);
+    for (const h of ["machine", "preset", "benchmark", "runs", "baseline", "latest", "latest vs baseline",
+      "last change", "at commit", "latest vs before it"]) text(el("th", {}, head), h);
+    for (const s of data.series) {
+      const r = el("tr", {}, t);
+      text(el("td", { title: s.machine_id }, r), s.machine + " " + s.machine_id.slice(0, 6));
+      text(el("td", {}, r), s.preset || "–");
+      text(el("a", { href: "#" + s.id }, el("td", {}, r)), s.benchmark);
+      text(el("td", {}, r), String(s.points.length));
+      text(el("td", {}, r), fmt(s.baseline) + " " + s.unit);
+      text(el("td", {}, r), fmt(s.latest) + " " + s.unit);
+      text(el("td", { class: s.latest_vs_baseline > 0 ? "slower" : "faster" }, r), pct(s.latest_vs_baseline));
+      const last = s.changes[s.changes.length - 1];
+      text(el("td", {}, r), last ? pct(last.change) : "none");
+      const at = el("td", {}, r);
+      if (last) commitNode(last.commit, at);
+      text(el("td", {}, r), pct(s.latest_vs_before_last_change));
+    }
+  }
+
+  // One row per benchmark: its series on every machine side by side, CPU before GPU, so a CPU and
+  // a GPU run of the same render (or two machines) can be read against each other.
+  function plots() {
+    const root = document.getElementById("plots");
+    const groups = new Map();
+    for (const s of data.series) {
+      if (!groups.has(s.group)) groups.set(s.group, []);
+      groups.get(s.group).push(s);
+    }
+    for (const [group, list] of groups) {
+      const row = el("div", { class: "row" }, root);
+      const devices = [...new Set(list.map((s) => s.device).filter(Boolean))].join(" | ");
+      text(el("h3", {}, row), group.replace("{device}", devices.includes("|") ? "[" + devices + "]" : devices || "-"));
+      list.sort((a, b) => (a.device + a.machine + a.preset < b.device + b.machine + b.preset ? -1 : 1));
+      for (const s of list) {
+        const panel = el("div", { class: "panel", id: s.id }, row);
+        const cap = el("p", { class: "caption" }, panel);
+        text(el("b", {}, cap), `${s.device ? s.device.toUpperCase() + " · " : ""}${s.machine} ${s.machine_id.slice(0, 6)}`);
+        text(cap, `${s.preset ? " · preset " + s.preset : ""} · ${s.points.length} runs · latest ${fmt(s.latest)} ` +
+          `${s.unit} (${pct(s.latest_vs_baseline)} vs first)`);
+        for (const c of s.changes) {
+          text(cap, ` · change ${pct(c.change)} ${c.p_value === null ? "(exact)" : "p=" + c.p_value.toExponential(1)} at `);
+          commitNode(c.commit, cap);
+        }
+        chart(s, "time", panel);
+        if (s.points.some((p) => p.rays.length)) chart(s, "rays", panel);
+      }
+    }
+  }
+
+  summary();
+  plots();
+  document.body.setAttribute("data-drawn", String(document.querySelectorAll("svg.chart").length));
+})();

@@ -1,0 +1,152 @@
+"""`pathbench history report --out DIR`: a static dashboard (index.html + dashboard.js + data
+inline; no server, nothing fetched from the network). Per benchmark and machine: time (and rays/s
+where recorded) over commits, every repetition drawn beside the median so the spread shows, change
+points marked with their commit, the latest run against the first (the baseline) and against the
+segment before its last change point; CPU and GPU series of one benchmark side by side. The plots
+are SVG drawn by dashboard.js (ours, ~200 lines), so the page works offline and in CI's headless
+chromium. PNG copies of the series with change points (matplotlib) go to DIR/png/ for the README.
+"""
+from __future__ import annotations
+
+import html
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+
+from . import changes as cp
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+MAX_PNG = 16
+
+
+def _subjects(repo: str | None, commits: set[str]) -> dict[str, str]:
+    if not repo or not commits:
+        return {}
+    try:
+        r = subprocess.run(["git", "-C", repo, "log", "--all", "--format=%H %s"], capture_output=True, text=True,
+                           timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return {}
+    out = {}
+    for line in r.stdout.splitlines():
+        sha, _, subject = line.partition(" ")
+        if sha in commits:
+            out[sha] = subject[:160]
+    return out
+
+
+def _group_key(benchmark: str) -> tuple[str, str]:
+    """('render/{device}/pixel/...', 'cpu') so the CPU and GPU series of one benchmark pair up."""
+    m = re.search(r"(^|/)(cpu|gpu)(/|$)", benchmark)
+    if not m:
+        return benchmark, ""
+    return benchmark[: m.start(2)] + "{device}" + benchmark[m.end(2):], m.group(2)
+
+
+def collect(db, repo: str | None = None, benchmark: str | None = None, max_pvalue=cp.DEFAULT_MAX_PVALUE,
+            min_change=cp.DEFAULT_MIN_CHANGE) -> dict:
+    machines = dict(db.execute("SELECT id, name FROM machines").fetchall())
+    units = dict(db.execute("SELECT benchmark, MIN(unit) FROM results GROUP BY benchmark").fetchall())
+    rays = {}
+    for rid, bench, value in db.execute("SELECT run_id, benchmark, rays_per_second FROM results "
+                                        "WHERE rays_per_second IS NOT NULL ORDER BY repetition"):
+        rays.setdefault((rid, bench), []).append(value)
+    all_series = cp.series(db, benchmark)
+    subjects = _subjects(repo, {p.commit for pts in all_series.values() for p in pts})
+    found = cp.find(db, benchmark, max_pvalue=max_pvalue, min_change=min_change)
+    by_series: dict[tuple[str, str, str], list] = {}
+    for c in found:
+        by_series.setdefault((c.benchmark, c.machine_id, c.preset), []).append(c)
+    series = []
+    for (bench, mid, preset), pts in sorted(all_series.items()):
+        group, device = _group_key(bench)
+        medians = [p.median for p in pts]
+        chs = sorted(by_series.get((bench, mid, preset), []), key=lambda c: c.index)
+        since = chs[-1].index if chs else 0
+        before_last = medians[chs[-2].index if len(chs) > 1 else 0: chs[-1].index] if chs else []
+        series.append({
+            "id": f"s{len(series)}", "benchmark": bench, "group": group, "device": device,
+            "machine": machines[mid], "machine_id": mid, "preset": preset, "unit": units.get(bench, ""),
+            "points": [{"commit": p.commit, "date": p.date, "subject": subjects.get(p.commit, ""),
+                        "values": p.values, "median": p.median, "rays": rays.get((p.run_id, bench), [])}
+                       for p in pts],
+            "changes": [{"index": c.index, "commit": c.commit, "previous_commit": c.previous_commit,
+                         "change": c.change, "p_value": c.p_value} for c in chs],
+            "latest": medians[-1], "baseline": medians[0],
+            "latest_vs_baseline": medians[-1] / medians[0] - 1 if medians[0] else None,
+            "latest_vs_before_last_change": (statistics.fmean(medians[since:]) / statistics.fmean(before_last) - 1)
+            if before_last else None,
+        })
+    return {"series": series, "changes": cp.as_json(found)}
+
+
+def _png(series: dict, path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    pts = series["points"]
+    fig, ax = plt.subplots(figsize=(9, 3.2), dpi=100)
+    for i, p in enumerate(pts):
+        ax.plot([i] * len(p["values"]), p["values"], ".", color="#9bb7d4", ms=4)
+    ax.plot(range(len(pts)), [p["median"] for p in pts], "-", color="#1f4e79", lw=1.5)
+    for c in series["changes"]:
+        ax.axvline(c["index"] - 0.5, color="#c0392b" if c["change"] > 0 else "#1e8449", ls="--", lw=1)
+        ax.annotate(f"{c['commit'][:7]} {c['change'] * 100:+.1f}%", (c["index"] - 0.4, ax.get_ylim()[1]),
+                    va="top", fontsize=8, color="#333")
+    step = max(1, len(pts) // 20)
+    ax.set_xticks(range(0, len(pts), step), [pts[i]["commit"][:7] for i in range(0, len(pts), step)],
+                  rotation=60, fontsize=7)
+    ax.set_ylabel(series["unit"])
+    ax.set_title(f"{series['benchmark']}  [{series['machine']} {series['machine_id'][:6]}, {series['preset']}]",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def png_name(series: dict) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "_", f"{series['machine']}_{series['preset']}_{series['benchmark']}").strip("_") + ".png"
+
+
+def _page(data: dict, commit_url: str) -> str:
+    blob = json.dumps(data, allow_nan=False).replace("</", "<\\/")
+    n_changes = len(data["changes"])
+    machines = sorted({s["machine"] for s in data["series"]})
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>pathbench performance history</title>
+<link rel="stylesheet" href="dashboard.css"></head>
+<body>
+<h1>pathbench performance history</h1>
+<p>{len(data['series'])} series on {len(machines)} machine(s): {html.escape(', '.join(machines))};
+{n_changes} change point(s). Lower is better in every plot but rays/s. Dots: repetitions; line: median per run;
+dashed: change points (red slower, green faster).</p>
+<details open><summary><b>Latest against baseline</b> (baseline: the first run of the series)</summary>
+<table id="summary"></table></details>
+<div id="plots"></div>
+<script id="history-data" type="application/json">{blob}</script>
+<script>window.COMMIT_URL = {json.dumps(commit_url)};</script>
+<script src="dashboard.js"></script>
+</body></html>
+"""
+
+
+def write_site(db, out: str, commit_url: str = "", png: bool = True, repo: str | None = None,
+               benchmark: str | None = None) -> int:
+    data = collect(db, repo, benchmark)
+    os.makedirs(out, exist_ok=True)
+    for name in ("dashboard.js", "dashboard.css"):
+        shutil.copy(os.path.join(HERE, name), os.path.join(out, name))
+    with open(os.path.join(out, "data.json"), "w") as f:
+        json.dump(data, f, indent=1, allow_nan=False)
+    with open(os.path.join(out, "index.html"), "w") as f:
+        f.write(_page(data, commit_url))
+    if png:
+        os.makedirs(os.path.join(out, "png"), exist_ok=True)
+        ranked = sorted((s for s in data["series"] if len(s["points"]) > 1),
+                        key=lambda s: (not s["changes"], s["benchmark"]))
+        for s in ranked[:MAX_PNG]:
+            _png(s, os.path.join(out, "png", png_name(s)))
+    return len(data["series"])
