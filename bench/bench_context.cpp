@@ -96,7 +96,7 @@ void finish_benchmark_json(const std::string& path) {
   ctx["load_average_at_end"] = first_line("/proc/loadavg");
   if (!run_start().is_null())
     ctx["run"] = nlohmann::ordered_json::parse(app::load_between(run_start(), end).dump());
-  app::write_text_file(path, doc.dump(2) + "\n");
+  write_text_file(path, doc.dump(2) + "\n");
 }
 
 }  // namespace pb::bench
