@@ -101,7 +101,12 @@ int run_bench(const BenchOptions& o, const std::vector<std::string>& passthrough
     throw std::runtime_error(fmt::format("{}: cannot run: {}", bin.string(), std::strerror(errno)));
   }
   const int status = run_child(bin, argv);
-  if (status != 0) return status;  // its message is on stderr; the temporary file goes
+  if (status != 0) {
+    // A truncated file (a full disk) also fails pathbench-bench's own strict-JSON
+    // rewrite; say what happened rather than pass on its exit status 1.
+    if (status < 128) check_complete_json(*out);
+    return status;  // its message is on stderr; the temporary file goes
+  }
   check_complete_json(*out);
   out->commit();
   return 0;
