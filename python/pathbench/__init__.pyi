@@ -37,7 +37,8 @@ class Scene:
                  ) -> npt.NDArray[np.bool_]: ...
 
 def load_scene(name_or_path: str, scale: float = 1.0,
-               offset: tuple[float, float, float] | list[float] = (0.0, 0.0, 0.0)) -> Scene: ...
+               offset: tuple[float, float, float] | list[float] = (0.0, 0.0, 0.0),
+               embree_layout: _Layout = "auto") -> Scene: ...
 def builtin_scenes() -> list[tuple[str, str]]: ...
 def gpu_available() -> tuple[bool, str]: ...
 
@@ -46,17 +47,18 @@ _Strategy = Literal["pixel", "wavefront", "paper-queue"]
 _Device = Literal["cpu", "gpu"]
 _Precision = Literal["float", "double"]
 _Layout = Literal["auto", "triangles", "quads"]
+_Isa = Literal["auto", "avx512", "avx2", "scalar"]
 _Image = npt.NDArray[np.float32]
 
 @overload
 def render(scene: Scene, width: int, height: int, spp: int, *, bounces: int | None = None,
            converged: bool = False, rr: bool = False, sampling: _Sampling = "nee", strategy: _Strategy = "pixel",
            device: _Device = "cpu", precision: _Precision = "float", embree_layout: _Layout = "auto",
-           seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
+           isa: _Isa = "auto", seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
            variance: Literal[False] = False, profile: bool = False) -> tuple[_Image, dict[str, object]]: ...
 @overload
 def render(scene: Scene, width: int, height: int, spp: int, *, bounces: int | None = None,
            converged: bool = False, rr: bool = False, sampling: _Sampling = "nee", strategy: _Strategy = "pixel",
            device: _Device = "cpu", precision: _Precision = "float", embree_layout: _Layout = "auto",
-           seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
+           isa: _Isa = "auto", seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
            variance: Literal[True], profile: bool = False) -> tuple[_Image, dict[str, object], _Image]: ...

@@ -98,10 +98,17 @@ py::array_t<bool> occluded(const SceneHandle& s, const py::handle& origins, cons
   return out;
 }
 
-std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::array<float, 3> offset) {
+std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::array<float, 3> offset,
+                                  const std::string& embree_layout) {
+  EmbreeLayout layout;
+  try {
+    layout = parse_embree_layout(embree_layout);
+  } catch (const InputError& e) {
+    throw py::value_error(pb::python::python_terms(e.what()));
+  }
   py::gil_scoped_release release;
   return std::make_shared<SceneHandle>(
-      pb::transformed(load_scene(name), scale, Vec3f{offset[0], offset[1], offset[2]}));
+      pb::transformed(load_scene(name), scale, Vec3f{offset[0], offset[1], offset[2]}), layout);
 }
 
 }  // namespace
@@ -183,9 +190,10 @@ PYBIND11_MODULE(_core, m) {
       });
 
   m.def("load_scene", &load, py::arg("name_or_path"), py::arg("scale") = 1.0f,
-        py::arg("offset") = std::array<float, 3>{0, 0, 0},
+        py::arg("offset") = std::array<float, 3>{0, 0, 0}, py::arg("embree_layout") = "auto",
         "A built-in scene ('paper-cornell', 'scaling:100000', ...) or a .json/.obj file, every point moved to\n"
-        "p * scale + offset (the camera too). ValueError names what is wrong.");
+        "p * scale + offset (the camera too); embree_layout as `--embree-layout` (auto, triangles, quads) for the\n"
+        "CPU ray casts. ValueError names what is wrong.");
   m.def("builtin_scenes", [] {
     py::list out;
     for (const auto& b : pb::builtin_scenes()) out.append(py::make_tuple(b.name, b.description));

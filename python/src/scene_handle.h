@@ -14,16 +14,19 @@ namespace pb::python {
 
 class SceneHandle {
  public:
-  explicit SceneHandle(Scene scene) : scene_(std::move(scene)) {}
+  // `layout`: how the Embree scene takes the triangles (--embree-layout; auto times both).
+  explicit SceneHandle(Scene scene, EmbreeLayout layout = EmbreeLayout::Auto)
+      : scene_(std::move(scene)), layout_(layout) {}
   const Scene& scene() const { return scene_; }
 
-  // The CPU tracer's Embree scene (EmbreeScene(scene, watertight)), built once per flag.
+  // The CPU tracer's Embree scene (EmbreeScene(scene, watertight, layout)), built once per flag.
   const cpu::EmbreeScene& embree(bool watertight) const;
   // The GPU tracer's BVH (build_bvh with its default options), kept on the host.
   const gpu::BvhHost& bvh() const;
 
  private:
   Scene scene_;
+  EmbreeLayout layout_;
   mutable std::mutex mutex_;
   mutable std::unique_ptr<cpu::EmbreeScene> embree_[2];  // [watertight]
   mutable std::unique_ptr<gpu::BvhHost> bvh_;

@@ -150,12 +150,13 @@ TEST(BadSettings, UnknownEmbreeLayout) {
 // apply_choices: the one path from named options to settings, for the CLI and the Python module.
 TEST(Settings, ApplyChoicesParsesEveryNameAndConverged) {
   RenderSettings s;
-  RenderChoices c{"cosine", "wavefront", "cpu", "double", "quads", true};
+  RenderChoices c{"cosine", "wavefront", "cpu", "double", "quads", "avx2", true};
   apply_choices(c, s);
   EXPECT_EQ(s.sampling, Sampling::Cosine);
   EXPECT_EQ(s.strategy, Strategy::Wavefront);
   EXPECT_EQ(s.precision, Precision::Double);
   EXPECT_EQ(s.embree_layout, EmbreeLayout::Quads);
+  EXPECT_EQ(s.isa, Isa::Avx2);
   EXPECT_EQ(s.max_bounces, -1);
   EXPECT_TRUE(s.russian_roulette);
 }
