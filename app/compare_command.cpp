@@ -175,21 +175,26 @@ std::string non_finite_to_null(const std::string& raw) {
 
 }  // namespace
 
-// The same text as ordered JSON (key order kept), for rewriting a bench file in place.
-nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const std::string& path) {
+namespace {
+
+// Benchmark JSON text with NaN/Infinity read as null, as `Json` (ordered or not).
+template <class Json> Json parse_benchmark_as(const std::string& path, const std::string& raw) {
   try {
-    return parse_json_bounded<nlohmann::ordered_json>(non_finite_to_null(raw), path);
+    return parse_json_bounded<Json>(non_finite_to_null(raw), path);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
   }
 }
 
+}  // namespace
+
+// The same text as ordered JSON (key order kept), for rewriting a bench file in place.
+nlohmann::ordered_json parse_benchmark_json_text(const std::string& raw, const std::string& path) {
+  return parse_benchmark_as<nlohmann::ordered_json>(path, raw);
+}
+
 nlohmann::json parse_benchmark_json(const std::string& path, const std::string& raw) {
-  try {
-    return parse_json_bounded<nlohmann::json>(non_finite_to_null(raw), path);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not JSON ({})", path, e.what()));
-  }
+  return parse_benchmark_as<nlohmann::json>(path, raw);
 }
 
 nlohmann::json read_benchmark_json(const std::string& path) {
