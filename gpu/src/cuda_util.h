@@ -87,6 +87,19 @@ template <class T> class DeviceBuffer {
   uint64_t n_ = 0;
 };
 
+// A stream and an event that are destroyed with their scope (timing brackets, the
+// render's own stream).
+struct ScopedStream {
+  cudaStream_t s = nullptr;
+  ScopedStream() { PB_CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking)); }
+  ~ScopedStream() { if (s) cudaStreamDestroy(s); }
+};
+struct ScopedEvent {
+  cudaEvent_t e = nullptr;
+  ScopedEvent() { PB_CUDA_CHECK(cudaEventCreate(&e)); }
+  ~ScopedEvent() { if (e) cudaEventDestroy(e); }
+};
+
 // The launch wrapper. Every kernel launched through it must begin with pdl_wait()
 // (kernel_sync.h). Each kernel's block size comes from the occupancy calculator
 // (cached); launches are counted per stage name and, when profiling, bracketed by CUDA
