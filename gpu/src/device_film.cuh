@@ -15,8 +15,8 @@ namespace pb::gpu {
 
 constexpr unsigned kFullMask = 0xFFFFFFFFu;
 
-// Film and counters on the device.
-
+// The film as the kernels see it: the one device view of a Film (its sums, counts and
+// variance sums on the device, its scale and sample limit).
 struct FilmDev {
   unsigned long long* sum;  // 3 per pixel, two's complement of Film's int64 sums
   uint32_t* count;
@@ -24,11 +24,6 @@ struct FilmDev {
   double scale;
   double limit;             // a channel must stay strictly below this (Film::sample_limit)
 };
-
-__device__ __forceinline__ bool sample_acceptable(const Vec3f& L, double limit) {
-  return isfinite(L.x) && isfinite(L.y) && isfinite(L.z) && double(fabsf(L.x)) < limit &&
-         double(fabsf(L.y)) < limit && double(fabsf(L.z)) < limit;
-}
 
 struct Stats {
   unsigned long long camera, bounce, shadow, paths, discarded;

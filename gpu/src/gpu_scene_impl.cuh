@@ -24,7 +24,7 @@ struct GpuScene::Impl {
   BvhView bvh{};
   uint64_t bytes = 0;
   uint32_t bvh_depth = 0, bvh_leaves = 0;
-  double bvh_sah = 0, bvh_build_seconds = 0, upload_seconds = 0;
+  double bvh_sah = 0, bvh_build_seconds = 0;
 };
 
 }  // namespace pb::gpu

@@ -42,7 +42,6 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   r.stats = host_ctr_->stats;
   r.stats.paths = r.stats.camera;
   r.state_bytes_per_path = state_bytes(shadows_);
-  r.queue_bytes_per_path = 0;  // the queues are the compacted state buffers themselves
   r.paths_in_flight = capacity_;
   r.pool_bytes = capacity_ * state_bytes(shadows_) + sizeof(WaveCounters);
   return r;

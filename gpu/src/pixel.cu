@@ -46,19 +46,19 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
 }
 
 
-__device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths, uint32_t discarded) {
-  __shared__ unsigned long long acc[4];
-  if (threadIdx.x < 4) acc[threadIdx.x] = 0;
+// The block's ray and path counts, one atomic per counter per block. (Discarded samples
+// are counted where they are rejected, in film_add_warp.)
+__device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths) {
+  __shared__ unsigned long long acc[3];
+  if (threadIdx.x < 3) acc[threadIdx.x] = 0;
   __syncthreads();
   bounce = __reduce_add_sync(kFullMask, bounce);
   shadow = __reduce_add_sync(kFullMask, shadow);
   paths = __reduce_add_sync(kFullMask, paths);
-  discarded = __reduce_add_sync(kFullMask, discarded);
   if ((threadIdx.x & 31) == 0) {
     atomicAdd(&acc[0], bounce);
     atomicAdd(&acc[1], shadow);
     atomicAdd(&acc[2], paths);
-    atomicAdd(&acc[3], discarded);
   }
   __syncthreads();
   if (threadIdx.x == 0) {
@@ -66,7 +66,6 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
     atomicAdd(&stats->shadow, acc[1]);
     atomicAdd(&stats->paths, acc[2]);
     atomicAdd(&stats->camera, acc[2]);
-    atomicAdd(&stats->discarded, acc[3]);
   }
 }
 
@@ -77,7 +76,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
   const uint32_t lane = threadIdx.x & 31;
   const uint64_t warp = (uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
   const uint64_t warps = (uint64_t(gridDim.x) * blockDim.x) >> 5;
-  uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0, n_discarded = 0;
+  uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0;
   for (uint64_t base = warp * 32; base < total; base += warps * 32) {
     const uint64_t g = base + lane;
     const bool valid = g < total;
@@ -89,7 +88,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
   }
-  block_stats_add(stats, n_bounce, n_shadow, n_paths, n_discarded);
+  block_stats_add(stats, n_bounce, n_shadow, n_paths);
 }
 
 }  // namespace

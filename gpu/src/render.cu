@@ -186,7 +186,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     x["iterations"] = r.iterations;
   }
   if (settings.strategy == Strategy::PaperQueue) {
-    x["bytes_per_task"] = r.state_bytes_per_path + r.queue_bytes_per_path;
+    x["bytes_per_task"] = r.state_bytes_per_path;  // the queues are the compacted state buffers themselves
     x["tasks"] = total;
   }
   if (settings.strategy == Strategy::Pixel) x["pixel_block"] = launch.block_size("pixel");

@@ -1,6 +1,5 @@
 // The scene upload: the BVH built on the host by Embree's builder (bvh_build.cpp), then
 // every array copied to the device once; a GpuScene serves many renders.
-#include <chrono>
 #include <memory>
 
 #include "device_facts.h"
@@ -13,7 +12,6 @@ GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   ensure_device();
   Impl& m = *impl_;
   const BvhHost bvh = build_bvh(scene);
-  const auto t0 = std::chrono::steady_clock::now();
   const char* lower = "the scene's size (fewer triangles)";
   m.positions.assign(scene.positions, "scene vertices", lower);
   m.triangles.assign(scene.triangles, "scene triangles", lower);
@@ -37,7 +35,6 @@ GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   m.bvh_leaves = bvh.leaves;
   m.bvh_sah = bvh.sah_cost;
   m.bvh_build_seconds = bvh.build_seconds;
-  m.upload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 GpuScene::~GpuScene() = default;

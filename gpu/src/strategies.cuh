@@ -17,7 +17,7 @@ namespace pb::gpu {
 
 struct FrameResult {
   Stats stats{};
-  uint64_t state_bytes_per_path = 0, queue_bytes_per_path = 0, paths_in_flight = 0, pool_bytes = 0;
+  uint64_t state_bytes_per_path = 0, paths_in_flight = 0, pool_bytes = 0;
   uint64_t iterations = 0;
 };
 
