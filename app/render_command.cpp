@@ -7,6 +7,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
 
 namespace pb::app {
 
@@ -51,7 +52,6 @@ void finish_render_options(RenderOptions& o) {
   }
   o.settings.variance = !o.variance_out.empty();
   o.settings.progress = !o.quiet;
-  o.settings.validate();
   for (const std::string* path : {&o.out, &o.variance_out}) {
     if (path->empty()) continue;
     std::string ext = std::filesystem::path(*path).extension().string();
@@ -69,7 +69,7 @@ int run_render(RenderOptions& o) {
   const Scene scene = load_scene(o.scene);
   Film film(o.settings.width, o.settings.height, o.settings.variance);
   RunReport report;
-  render_on_device(scene, o.settings, film, report, o.profile);
+  run::render(scene, o.settings, film, report, {.profile = o.profile});
 
   if (!o.out.empty()) write_image(o.out, film.mean(), film.width(), film.height());
   if (!o.variance_out.empty()) write_image(o.variance_out, film.variance_of_mean(), film.width(), film.height());

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "cuda_util.h"
 #include "pathbench/common/errors.h"
@@ -68,7 +69,9 @@ void ensure_device() {
   if (!device_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
 }
 
-bool device_available(std::string* why_not) {
+namespace {
+// The probe behind device_available, run once per process.
+bool probe_device(std::string* why_not) {
   int n = 0;
   cudaError_t e = cudaGetDeviceCount(&n);
   if (e != cudaSuccess || n == 0) {
@@ -92,6 +95,19 @@ bool device_available(std::string* why_not) {
     return false;
   }
   return true;
+}
+}  // namespace
+
+bool device_available(std::string* why_not) {
+  // Once per process: every entry point (the run layer, GpuScene, device_info) asks,
+  // and the answer cannot change while the process runs.
+  static const std::pair<bool, std::string> answer = [] {
+    std::string why;
+    const bool ok = probe_device(&why);
+    return std::make_pair(ok, why);
+  }();
+  if (!answer.first && why_not) *why_not = answer.second;
+  return answer.first;
 }
 
 DeviceInfo device_info() {

@@ -37,8 +37,6 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
 }  // namespace
 
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile) {
-  ensure_device();
-  settings.validate();
   // Start the context before measuring memory: its own use is not the tracer's.
   PB_CUDA_CHECK(cudaFree(nullptr));
   DeviceMemory::instance().begin_measurement();
@@ -48,8 +46,6 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
 
 void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film, RunReport& report,
             bool profile) {
-  ensure_device();
-  settings.validate();
   DeviceMemory::instance().begin_measurement();
   render_impl(scene, gpu_scene, settings, film, report, profile);
 }
@@ -59,7 +55,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
                  RunReport& report, bool profile) {
   if (film.width() != settings.width || film.height() != settings.height)
     throw std::logic_error("film size does not match the settings");
-  const DeviceInfo info = device_info();
+  const DeviceInfo info = device_info();  // the device was checked by the run layer (cached)
   const GpuScene::Impl& g = gpu_scene.impl();
   DeviceMemory& mem = DeviceMemory::instance();
 
@@ -67,7 +63,6 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   const uint32_t pixels = settings.width * settings.height;
   const uint64_t total = settings.total_samples();
   const ShadowUse shadows = ShadowUse::of(scene, settings);
-  film.begin(settings.spp, scene.max_emission());
 
   ScopedStream stream;
   Launcher launch(stream.s, profile);
@@ -141,9 +136,6 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   fb.count.download(film.counts().data(), fb.count.size());
   if (film.has_variance()) fb.sum_sq.download(film.raw_sum_sq().data(), fb.sum_sq.size());
 
-  report.scene = scene.name;
-  report.triangles = scene.triangles.size();
-  report.settings = settings;
   report.seconds = std::chrono::duration<double>(t1 - t0).count();
   report.device_seconds = double(device_ms) / 1e3;
   report.rays.camera = r.stats.camera;
@@ -154,7 +146,6 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   report.state_bytes_per_path = r.state_bytes_per_path;
   report.paths_in_flight = r.paths_in_flight;
   report.threads = 0;
-  report.peak_host_bytes = peak_resident_bytes();
   report.tracer_host_bytes = film.bytes();
   report.peak_device_bytes = std::max(mem.peak_allocated(), mem.peak_meminfo_delta());
   auto& x = report.extra;

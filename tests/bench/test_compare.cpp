@@ -8,14 +8,14 @@
 #include <string>
 #include <sys/wait.h>
 
-#include "compare_command.h"
+#include "pathbench/analysis/bench_compare.h"
 #include "pathbench/common/errors.h"
 
 namespace {
 
-using pb::app::CompareOptions;
-using pb::app::mann_whitney_u;
-using pb::app::run_compare;
+using pb::analysis::CompareOptions;
+using pb::analysis::mann_whitney_u;
+using pb::analysis::run_compare;
 
 const std::string kData = std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/bench/";
 
@@ -30,7 +30,7 @@ int compare(const std::string& base, const std::string& next, double threshold =
 
 // A copy of `in` with every iteration's time (and rays/s inversely) scaled by `f`.
 std::string scaled_copy(const std::string& in, double f, const std::string& name) {
-  nlohmann::json j = pb::app::read_benchmark_json(in);
+  nlohmann::json j = pb::analysis::read_benchmark_json(in);
   for (auto& b : j["benchmarks"]) {
     for (const char* k : {"real_time", "cpu_time"})
       if (b.contains(k)) b[k] = b[k].get<double>() * f;
@@ -95,12 +95,12 @@ TEST(Compare, NoisyButEqualIsNotARegression) {
 }
 
 TEST(Compare, VerdictsPerBenchmark) {
-  auto base = pb::app::load_benchmark_json(kData + "base.json", 9);
-  auto slow = pb::app::load_benchmark_json(kData + "slower10.json", 9);
-  auto rows = pb::app::compare_files(base, slow, 0.05, 0.05);
+  auto base = pb::analysis::load_benchmark_json(kData + "base.json", 9);
+  auto slow = pb::analysis::load_benchmark_json(kData + "slower10.json", 9);
+  auto rows = pb::analysis::compare_files(base, slow, 0.05, 0.05);
   ASSERT_EQ(rows.size(), 3u);
   for (const auto& r : rows) {
-    EXPECT_EQ(r.verdict, pb::app::Verdict::Regressed) << r.name;
+    EXPECT_EQ(r.verdict, pb::analysis::Verdict::Regressed) << r.name;
     EXPECT_NEAR(r.time_change, 0.10, 1e-9) << r.name;
     EXPECT_TRUE(r.has_rays);
     EXPECT_NEAR(r.rays_change, 1 / 1.1 - 1, 1e-9) << r.name;

@@ -16,6 +16,7 @@
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "furnace_check.h"
 #include "stat_test.h"
 #ifdef PB_STABILITY_ON_GPU
@@ -58,19 +59,20 @@ Rendered render(const Scene& scene, RenderSettings s) {
   Rendered r{Film(s.width, s.height, s.variance), {}};
 #ifdef PB_STABILITY_ON_GPU
   s.strategy = Strategy::Pixel;
-  gpu::render(scene, s, r.film, r.report, false);
+  s.device = Device::Gpu;
+  run::render(scene, s, r.film, r.report);
   // The wavefront must agree bit for bit, extremes included (it has queues to overflow
   // and counters to wrap that the megakernel has not).
   RenderSettings w = s;
   w.strategy = Strategy::Wavefront;
   Film wf(s.width, s.height, s.variance);
   RunReport wr;
-  gpu::render(scene, w, wf, wr, false);
+  run::render(scene, w, wf, wr);
   EXPECT_TRUE(wf.raw_sums() == r.film.raw_sums()) << "GPU wavefront film differs from pixel's";
   EXPECT_TRUE(wf.counts() == r.film.counts()) << "GPU wavefront sample counts differ from pixel's";
   EXPECT_EQ(wr.discarded_samples, r.report.discarded_samples);
 #else
-  cpu::render(scene, s, r.film, r.report);
+  run::render(scene, s, r.film, r.report);
 #endif
   return r;
 }
@@ -200,7 +202,8 @@ std::vector<float> closest_hit_distances(const Scene& scene, const std::vector<s
   for (const gpu::TraceResult& h : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
     t.push_back(h.prim == gpu::kNoHit ? kMiss : h.t);
 #else
-  const cpu::EmbreeScene embree(scene, /*watertight=*/true, layout);
+  const auto embree_scene = cpu::make_embree_scene(scene, /*watertight=*/true, layout);
+  const cpu::EmbreeScene& embree = *embree_scene;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   for (const auto& [o, d] : rays) {

@@ -14,6 +14,7 @@
 #include "pathbench/common/path.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 
 #pragma GCC push_options
 #pragma GCC target("avx2")
@@ -49,7 +50,7 @@ Film render(const Scene& scene, Strategy strategy, int threads, Sampling samplin
   s.progress = false;
   Film film(s.width, s.height, false);
   RunReport report;
-  cpu::render(scene, s, film, report);
+  run::render(scene, s, film, report);
   return film;
 }
 
