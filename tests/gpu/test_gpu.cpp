@@ -10,7 +10,6 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/gpu/bvh_build.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"

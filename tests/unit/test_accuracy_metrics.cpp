@@ -10,7 +10,6 @@
 
 #include "pathbench/analysis/accuracy_metrics.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/run.h"
 
 namespace pb::analysis {

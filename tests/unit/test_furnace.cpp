@@ -6,7 +6,6 @@
 #include <cmath>
 
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/run.h"
 #include "furnace_check.h"
 

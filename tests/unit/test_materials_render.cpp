@@ -23,7 +23,6 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/features.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/run.h"
 #include "furnace_check.h"
 

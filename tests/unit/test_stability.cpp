@@ -15,7 +15,6 @@
 
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/run.h"
 #include "furnace_check.h"
 #include "stat_test.h"

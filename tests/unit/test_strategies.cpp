@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/run.h"
 
 namespace pb {

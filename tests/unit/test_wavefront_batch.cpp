@@ -13,7 +13,6 @@
 
 #include "pathbench/common/path.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/run.h"
 
 #pragma GCC push_options
