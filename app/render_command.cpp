@@ -12,6 +12,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
 
 namespace pb::app {
 
@@ -63,7 +64,6 @@ void finish_render_options(RenderOptions& o) {
   }
   o.settings.variance = !o.variance_out.empty();
   o.settings.progress = !o.quiet;
-  o.settings.validate();
   for (const std::string* path : {&o.out, &o.variance_out}) {
     if (path->empty()) continue;
     const std::string ext = image_extension(*path);
@@ -95,7 +95,7 @@ int run_render(RenderOptions& o) {
   const Scene scene = load_scene(o.scene);
   Film film(o.settings.width, o.settings.height, o.settings.variance);
   RunReport report;
-  render_on_device(scene, o.settings, film, report, o.profile);
+  run::render(scene, o.settings, film, report, {.profile = o.profile});
 
   // Each output goes to its own temporary file; only when all are complete are they
   // renamed into place, so a failure (a full disk) leaves none of them.

@@ -13,10 +13,10 @@
 #include <memory>
 #include <string>
 
-#include "device_render.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
 #include "ray_cast.h"
 #include "scene_handle.h"
 
@@ -157,13 +157,12 @@ py::tuple render(const SceneHandle& s, uint32_t width, uint32_t height, uint32_t
   rs.threads = threads;
   rs.watertight = watertight;
   rs.progress = false;
-  rs.validate();
   Film film(width, height, false);
   RunReport report;
   std::vector<float> mean;
   {
     py::gil_scoped_release release;
-    app::render_on_device(s.scene(), rs, film, report, profile);
+    run::render(s.scene(), rs, film, report, {.profile = profile});
     mean = film.mean();
   }
   py::array_t<float> image({py::ssize_t(height), py::ssize_t(width), py::ssize_t(3)});

@@ -17,7 +17,7 @@ class SceneHandle {
   explicit SceneHandle(Scene scene) : scene_(std::move(scene)) {}
   const Scene& scene() const { return scene_; }
 
-  // The CPU tracer's Embree scene (EmbreeScene(scene, watertight)), built once per flag.
+  // The CPU tracer's Embree scene (make_embree_scene(scene, watertight)), built once per flag.
   const cpu::EmbreeScene& embree(bool watertight) const;
   // The GPU tracer's BVH (build_bvh with its default options), kept on the host.
   const gpu::BvhHost& bvh() const;

@@ -1,31 +1,16 @@
-#include "device_render.h"
-
-#include <fmt/core.h>
+#include "pathbench/run/run_context.h"
 
 #include <chrono>
-#include <filesystem>
-#include <fstream>
-#include <stdexcept>
+#include <string>
 
-#include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/cpu/embree_facts.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/device_facts.h"
-#include "pathbench/gpu/render.h"
 #endif
 
-namespace pb::app {
-
-bool gpu_available(std::string* why_not) {
-#if PATHBENCH_HAVE_CUDA
-  return pb::gpu::device_available(why_not);
-#else
-  if (why_not) *why_not = "this build has no CUDA tracer (configure with -DPATHBENCH_CUDA=ON and nvcc on PATH)";
-  return false;
-#endif
-}
+namespace pb::run {
 
 nlohmann::json run_fingerprint(bool with_gpu) {
   nlohmann::json fp = machine_fingerprint();
@@ -67,31 +52,4 @@ nlohmann::json load_between(const nlohmann::json& start, const nlohmann::json& e
           {"cpu_per_wall", wall > 0 ? nlohmann::json(cpu / wall) : nlohmann::json(nullptr)}};
 }
 
-void render_on_device(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, bool profile) {
-  const nlohmann::json start = load_sample();
-  if (s.device == Device::Cpu) {
-    cpu::render(scene, s, film, report);
-  } else {
-    std::string why;
-    if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
-#if PATHBENCH_HAVE_CUDA
-    gpu::render(scene, s, film, report, profile);
-#else
-    (void)profile;
-#endif
-  }
-  report.load = load_between(start, load_sample());
-  report.fingerprint = run_fingerprint(s.device == Device::Gpu);
-}
-
-double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
-
-std::string machine_folder(Device device) {
-#if PATHBENCH_HAVE_CUDA
-  if (device == Device::Gpu) return gpu::device_info().slug;
-#endif
-  (void)device;
-  return machine_slug();
-}
-
-}  // namespace pb::app
+}  // namespace pb::run
