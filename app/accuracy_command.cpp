@@ -11,20 +11,24 @@
 #include <sstream>
 #include <vector>
 
-#include "accuracy_metrics.h"
 #include "accuracy_reference.h"
 #include "cli_checks.h"
-#include "device_render.h"
+#include "pathbench/analysis/accuracy_metrics.h"
+#include "pathbench/common/output_file.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
+#include "pathbench/run/run_context.h"
 
 #ifndef PATHBENCH_SOURCE_DIR
 #define PATHBENCH_SOURCE_DIR "."
 #endif
 
 namespace pb::app {
+
+using namespace pb::analysis;  // the error metrics this command reports
 
 namespace fs = std::filesystem;
 
@@ -177,10 +181,10 @@ int run_accuracy(AccuracyOptions& o) {
   const std::vector<Config> configs = selected_configs(o.configs);
   if (base.device == Device::Gpu) {
     std::string why;
-    if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+    if (!run::gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
   }
   const Scene scene = load_scene(o.scene);
-  const std::string dir = o.out_dir.empty() ? "results/" + machine_folder(base.device) + "/accuracy" : o.out_dir;
+  const std::string dir = o.out_dir.empty() ? "results/" + run::machine_folder(base.device) + "/accuracy" : o.out_dir;
   const std::string stem = fmt::format("{}-{}x{}-{}", slugify(scene.name, "scene"), o.width, o.height, to_string(base.device));
   const std::string image_dir = "images/" + stem;
   check_output_path((fs::path(dir) / (stem + ".json")).string(), "--out-dir");  // before the sweep
@@ -199,9 +203,9 @@ int run_accuracy(AccuracyOptions& o) {
   out["date"] = utc_now();
   out["git_revision"] = git_revision();
   out["compiler"] = compiler_id();
-  out["machine"] = {{"slug", machine_folder(base.device)}, {"cpu", cpu_model()}, {"hardware_threads", hardware_threads()}};
+  out["machine"] = {{"slug", run::machine_folder(base.device)}, {"cpu", cpu_model()}, {"hardware_threads", hardware_threads()}};
   out["load_average_at_start"] = load_average();
-  out["fingerprint"] = run_fingerprint(base.device == Device::Gpu);
+  out["fingerprint"] = run::run_fingerprint(base.device == Device::Gpu);
   out["ladder"] = {{"max_spp", o.max_spp}, {"max_seconds", o.max_seconds}, {"factor", 4}};
   out["metrics"] = {
       {"rmse", "sqrt(mean over pixel-channels of (x - ref)^2)"},
@@ -260,7 +264,7 @@ int run_accuracy(AccuracyOptions& o) {
         if (report.extra.contains("gpu")) out["machine"]["gpu"] = report.extra["gpu"];
       }
       const std::vector<float> img = film.mean(), var = film.variance_of_mean();
-      const double secs = render_seconds(report);
+      const double secs = run::render_seconds(report);
       const ImageError err = image_error(img, ref.mean);
       // At 1 spp the film has no variance estimate, so no standard error either.
       const Bias bias = relative_bias(img, spp >= 2 ? var : std::vector<float>{}, ref.mean, ref.var);

@@ -5,12 +5,13 @@
 #include <filesystem>
 #include <fstream>
 
-#include "device_render.h"
+#include "pathbench/common/output_file.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/report.h"
+#include "pathbench/run/run.h"
 
 namespace pb::app {
 
@@ -45,7 +46,7 @@ bool try_load(const std::string& dir, const std::string& stem, const RenderSetti
 bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
                                std::string& refusal) {
   try {
-    render_on_device(scene, s, film, report, false);
+    run::render(scene, s, film, report);
     return true;
   } catch (const InputError& e) {
     if (s.device != Device::Gpu) throw;
@@ -83,7 +84,7 @@ Reference load_or_render_reference(const Scene& scene, const RenderSettings& bas
     fmt::print(stderr, "accuracy: reference in double refused by the GPU ({}); rendering it in float\n", refusal);
     s.precision = Precision::Float;
     film = Film(s.width, s.height, true);
-    render_on_device(scene, s, film, report, false);
+    run::render(scene, s, film, report);
   }
   ref.mean = film.mean();
   ref.var = film.variance_of_mean();
@@ -93,7 +94,7 @@ Reference load_or_render_reference(const Scene& scene, const RenderSettings& bas
   ref.info = {{"version", kReferenceVersion},
               {"file", stem + ".pfm"},
               {"variance_file", stem + "-var.pfm"},
-              {"seconds", render_seconds(report)},
+              {"seconds", run::render_seconds(report)},
               {"report", report.to_json()}};
   write_text_file((fs::path(dir) / (stem + ".json")).string(), ref.info.dump(2) + "\n");
   ref.info["cached"] = false;

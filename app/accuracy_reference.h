@@ -26,7 +26,7 @@ struct Reference {
   nlohmann::json info;           // settings, seconds, file names, whether it came from the cache
 };
 
-// Renders like render_on_device, except that a GPU refusing the settings
+// Renders like run::render, except that a GPU refusing the settings
 // (InputError, e.g. a tracer without double precision) returns false with the reason
 // instead of throwing: the sweep notes it and goes on. CPU errors still throw.
 bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,

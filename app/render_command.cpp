@@ -12,6 +12,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
 
 namespace pb::app {
 
@@ -83,9 +84,9 @@ void finish_render_options(RenderOptions& o) {
 int run_render(RenderOptions& o) {
   finish_render_options(o);
   const Scene scene = load_scene(o.scene);
-  Film film(o.settings.width, o.settings.height, o.settings.variance);
+  Film film;  // sized and begun by run::render, after it has validated the settings
   RunReport report;
-  render_on_device(scene, o.settings, film, report, o.profile);
+  run::render(scene, o.settings, film, report, {.profile = o.profile});
 
   // Each output goes to its own temporary file; only when all are complete are they
   // renamed into place, so a failure (a full disk) leaves none of them.

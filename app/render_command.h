@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "device_render.h"  // render_on_device, gpu_available, write_text_file
+#include "pathbench/common/output_file.h"  // write_text_file
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"

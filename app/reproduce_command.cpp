@@ -7,11 +7,12 @@
 #include <vector>
 
 #include "cli_checks.h"
-#include "device_render.h"
+#include "pathbench/common/output_file.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
 
 namespace pb::app {
 
@@ -64,7 +65,7 @@ double cpu_seconds_per_spp(const Scene& scene, Sampling sampling, int threads) {
   s.progress = false;
   Film film(s.width, s.height, false);
   RunReport r;
-  render_on_device(scene, s, film, r, false);
+  run::render(scene, s, film, r);
   return r.seconds / kProbeSpp;
 }
 
@@ -111,7 +112,7 @@ int run_reproduce(const ReproduceOptions& o) {
   if (o.spp == 0) throw InputError("--spp: must be at least 1");
   std::vector<Device> devices;
   std::string why_no_gpu;
-  const bool have_gpu = gpu_available(&why_no_gpu);
+  const bool have_gpu = run::gpu_available(&why_no_gpu);
   if (o.device != "gpu") devices.push_back(Device::Cpu);
   if (o.device == "gpu" && !have_gpu) throw InputError(fmt::format("--device gpu: {}", why_no_gpu));
   if (o.device != "cpu" && have_gpu) devices.push_back(Device::Gpu);
@@ -139,7 +140,7 @@ int run_reproduce(const ReproduceOptions& o) {
         Film film(s.width, s.height, false);
         RunReport r;
         try {
-          render_on_device(scene, s, film, r, false);
+          run::render(scene, s, film, r);
         } catch (const std::exception& e) {
           // The paper's queue may not fit: a row saying so, not a failed run.
           if (strategy != Strategy::PaperQueue) throw;
@@ -191,7 +192,7 @@ int run_reproduce(const ReproduceOptions& o) {
                         to_string(r.settings.sampling), r.settings.spp, r.extra["error"].get<std::string>());
       continue;
     }
-    const double secs = render_seconds(r);
+    const double secs = run::render_seconds(r);
     const double at_spp = secs * double(o.spp) / double(r.settings.spp);
     const bool row_scaled = r.settings.spp != o.spp;
     scaled |= row_scaled;

@@ -10,11 +10,12 @@
 #include <iterator>
 #include <stdexcept>
 
-#include "compare_command.h"
-#include "device_render.h"
+#include "pathbench/analysis/bench_compare.h"
 #include "pathbench/common/fingerprint.h"
+#include "pathbench/common/output_file.h"
 #include "pathbench/common/report.h"
 #include "pathbench/cpu/isa.h"
+#include "pathbench/run/run_context.h"
 
 namespace pb::bench {
 
@@ -38,7 +39,7 @@ void add(const char* key, const std::string& value) { benchmark::AddCustomContex
 
 // Fingerprint with the GPU's section where this build has the GPU tracer.
 const nlohmann::json& fingerprint() {
-  static const nlohmann::json fp = app::run_fingerprint(PATHBENCH_BENCH_GPU != 0);
+  static const nlohmann::json fp = run::run_fingerprint(PATHBENCH_BENCH_GPU != 0);
   return fp;
 }
 
@@ -50,7 +51,7 @@ nlohmann::json& run_start() {
 }  // namespace
 
 void add_environment_context(const std::string& preset) {
-  run_start() = app::load_sample();
+  run_start() = run::load_sample();
   const nlohmann::json& fp = fingerprint();
   const nlohmann::json& build = fp["build"];
   add("pathbench_preset", preset);
@@ -88,14 +89,14 @@ void finish_benchmark_json(const std::string& path) {
   // Google Benchmark writes NaN for the cv of a counter that is always zero (0 / 0);
   // the tolerant parser reads it as null. Duplicate keys collapse on parsing (and no
   // counter of ours is named like one of Google Benchmark's keys).
-  nlohmann::ordered_json doc = app::parse_benchmark_json_text(raw, path);
-  const nlohmann::json end = app::load_sample();
+  nlohmann::ordered_json doc = analysis::parse_benchmark_json_text(raw, path);
+  const nlohmann::json end = run::load_sample();
   auto& ctx = doc["context"];
   ctx["machine_id"] = fingerprint()["machine_id"];
   ctx["fingerprint"] = nlohmann::ordered_json::parse(fingerprint().dump());
   ctx["load_average_at_end"] = first_line("/proc/loadavg");
   if (!run_start().is_null())
-    ctx["run"] = nlohmann::ordered_json::parse(app::load_between(run_start(), end).dump());
+    ctx["run"] = nlohmann::ordered_json::parse(run::load_between(run_start(), end).dump());
   write_text_file(path, doc.dump(2) + "\n");
 }
 

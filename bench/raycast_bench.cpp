@@ -180,7 +180,7 @@ void run_raycast(benchmark::State& state, const RaycastCase& c, Api api, bool co
     if (!prep) {
       std::shared_ptr<const Scene> scene = cached_scene(c.scene);
       prep = std::make_shared<Prepared>();
-      prep->embree = std::make_unique<cpu::EmbreeScene>(*scene, RenderSettings{}.watertight);  // as the tracers run by default
+      prep->embree = cpu::make_embree_scene(*scene, RenderSettings{}.watertight);  // as the tracers run by default
       prep->rays = make_ray_sets(*scene, *prep->embree, c.width, c.height);
       store_extra(c.scene, kind, prep);
     }

@@ -12,8 +12,8 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/gpu/render.h"
+#include "pathbench/run/run.h"
 #include "raycast_bench.h"
-#include "device_render.h"
 #include "scene_cache.h"
 
 namespace pb::bench {
@@ -42,7 +42,7 @@ std::vector<gpu::TraceQuery> to_queries(const RaySet& s, bool any_hit) {
 
 void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit, bool coherent) {
   std::string why;
-  if (!app::gpu_available(&why)) {
+  if (!run::gpu_available(&why)) {
     state.SkipWithError(("no GPU: " + why).c_str());
     return;
   }
@@ -52,8 +52,8 @@ void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit
     prep = std::static_pointer_cast<GpuPrepared>(cached_extra(c.scene, kind));
     if (!prep) {
       std::shared_ptr<const Scene> scene = cached_scene(c.scene);
-      const cpu::EmbreeScene embree(*scene, RenderSettings{}.watertight);
-      const RaySets rays = make_ray_sets(*scene, embree, c.width, c.height);
+      const RaySets rays = make_ray_sets(*scene, *cpu::make_embree_scene(*scene, RenderSettings{}.watertight), c.width,
+                                         c.height);
       prep = std::make_shared<GpuPrepared>();
       prep->scene = std::make_unique<gpu::GpuScene>(*scene);
       prep->coherent = to_queries(rays.coherent, any_hit);

@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <fstream>
 
-#include "device_render.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
+#include "pathbench/run/run.h"
 #include "scene_cache.h"
 
 namespace pb::bench {
@@ -35,7 +35,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   const RenderSettings& s = c.settings;
   if (s.device == Device::Gpu) {
     std::string why;
-    if (!app::gpu_available(&why)) {
+    if (!run::gpu_available(&why)) {
       state.SkipWithError(("no GPU: " + why).c_str());
       return;
     }
@@ -56,7 +56,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
     reset_peak_rss();
     RunReport r;
     try {
-      app::render_on_device(*scene, s, film, r, false);
+      run::render(*scene, s, film, r);
     } catch (const std::exception& e) {
       state.SkipWithError(e.what());
       break;

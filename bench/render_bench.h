@@ -1,5 +1,5 @@
 #pragma once
-// Render benchmarks: one full render per iteration through pb::app::render_on_device,
+// Render benchmarks: one full render per iteration through pb::run::render,
 // named render/<device>/<strategy>/<scene>/<W>x<H>/spp:<N>/bounces:<B>/<sampling>.
 //
 // Time is manual: the RunReport's render time (CPU: host clock around the render,

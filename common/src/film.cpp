@@ -26,10 +26,6 @@ void Film::begin(uint64_t spp, float max_emission) {
   std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
 }
 
-FilmView Film::view() {
-  return {sum_.data(), count_.data(), sum_sq_.empty() ? nullptr : sum_sq_.data(), scale_, width_, height_};
-}
-
 size_t Film::bytes() const {
   return sum_.size() * sizeof(int64_t) + count_.size() * sizeof(uint32_t) + sum_sq_.size() * sizeof(double);
 }

@@ -91,7 +91,6 @@ void apply_choices(const RenderChoices& c, RenderSettings& s) {
     s.max_bounces = -1;
     s.russian_roulette = true;
   }
-  s.validate();
 }
 
 void RenderSettings::validate() const {

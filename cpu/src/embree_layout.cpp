@@ -87,7 +87,7 @@ double trace_ns_per_ray(const EmbreeScene& e, const ProbeRays& r) {
   return std::chrono::duration<double, std::nano>(t1 - t0).count() / double(r.closest.size() + r.shadow.size());
 }
 
-LayoutChoice measure(const Scene& s, bool watertight) {
+LayoutChoice measure(const Scene& s, bool watertight, TrianglePairs& pairs) {
   LayoutChoice c;
   if (s.triangles.empty()) {
     c.reason = "no triangles";
@@ -97,12 +97,14 @@ LayoutChoice measure(const Scene& s, bool watertight) {
     c.reason = "over 65536 triangles: not probed";
     return c;
   }
-  c.paired = pair_triangles(s).paired;
+  pairs = pair_triangles(s);
+  c.paired = pairs.paired;
   if (c.paired < kMinPairedShare * double(s.triangles.size())) {
     c.reason = "fewer than 90% of the triangles pair up";
     return c;
   }
-  const EmbreeScene triangles(s, watertight, EmbreeLayout::Triangles), quads(s, watertight, EmbreeLayout::Quads);
+  const EmbreeScene triangles(s, watertight, LayoutChoice{EmbreeLayout::Triangles}),
+      quads(s, watertight, LayoutChoice{EmbreeLayout::Quads}, pairs);
   const ProbeRays rays = probe_rays(s);
   trace_ns_per_ray(triangles, rays);  // warm-up: caches, lazily built parts
   trace_ns_per_ray(quads, rays);
@@ -136,13 +138,16 @@ uint64_t fingerprint(const Scene& s, bool watertight) {
 
 }  // namespace
 
-LayoutChoice choose_embree_layout(const Scene& s, bool watertight) {
+LayoutChoice choose_embree_layout(const Scene& s, bool watertight, TrianglePairs* pairs) {
   static std::mutex mutex;
   static std::map<uint64_t, LayoutChoice> known;
   const uint64_t key = fingerprint(s, watertight);
   const std::lock_guard<std::mutex> lock(mutex);
   if (auto it = known.find(key); it != known.end()) return it->second;
-  return known[key] = measure(s, watertight);
+  TrianglePairs made;
+  known[key] = measure(s, watertight, made);
+  if (pairs) *pairs = std::move(made);
+  return known[key];
 }
 
 }  // namespace pb::cpu

@@ -6,6 +6,7 @@
 
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 
 namespace pb::cpu {
 
@@ -24,11 +25,21 @@ bool EmbreeScene::monitor(void* self_ptr, ssize_t bytes, bool) {
   return true;
 }
 
-EmbreeScene::EmbreeScene(const Scene& s, bool watertight, EmbreeLayout layout) {
-  choice_ = layout == EmbreeLayout::Auto ? choose_embree_layout(s, watertight)
-                                         : LayoutChoice{layout, 0, 0.0, 0.0, "asked for"};
-  quads_ = choice_.layout == EmbreeLayout::Quads;
-  if (quads_) pairs_ = pair_triangles(s);
+std::unique_ptr<EmbreeScene> make_embree_scene(const Scene& s, bool watertight, EmbreeLayout layout) {
+  TrianglePairs pairs;
+  const LayoutChoice choice = layout == EmbreeLayout::Auto ? choose_embree_layout(s, watertight, &pairs)
+                                                           : LayoutChoice{layout, 0, 0.0, 0.0, "asked for"};
+  // The probe paired the triangles unless its answer was remembered; pair only then.
+  if (choice.layout != EmbreeLayout::Quads) pairs = {};
+  else if (pairs.quads.empty()) pairs = pair_triangles(s);
+  return std::make_unique<EmbreeScene>(s, watertight, choice, std::move(pairs));
+}
+
+EmbreeScene::EmbreeScene(const Scene& s, bool watertight, const LayoutChoice& choice, TrianglePairs pairs)
+    : choice_(choice), quads_(choice.layout == EmbreeLayout::Quads), pairs_(std::move(pairs)) {
+  if (choice_.layout == EmbreeLayout::Auto) throw std::logic_error("EmbreeScene: resolve Auto first (make_embree_scene)");
+  if (quads_ && pairs_.quads.empty() && !s.triangles.empty())
+    throw std::logic_error("EmbreeScene: the quads layout needs the triangle pairs");
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
   rtcSetDeviceErrorFunction(device_, on_error, nullptr);

@@ -18,7 +18,6 @@ namespace pb::cpu {
 uint64_t default_paths_in_flight(int threads) { return uint64_t(threads) * 4096; }
 
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report) {
-  settings.validate();
   if (settings.strategy == Strategy::PaperQueue)
     throw InputError("--strategy paper-queue: the paper's global queue is a GPU strategy; the CPU runs pixel or wavefront");
   if (film.width() != settings.width || film.height() != settings.height)
@@ -30,8 +29,8 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
   const int threads = settings.threads > 0 ? settings.threads : tbb::this_task_arena::max_concurrency();
 
-  EmbreeScene embree(scene, settings.watertight, settings.embree_layout);
-  film.begin(settings.spp, scene.max_emission());
+  const std::unique_ptr<EmbreeScene> embree_scene = make_embree_scene(scene, settings.watertight, settings.embree_layout);
+  const EmbreeScene& embree = *embree_scene;
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
                     settings.total_samples(), settings.progress);
   TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress, isa};
@@ -51,9 +50,6 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   const auto t1 = std::chrono::steady_clock::now();
   progress.finish();
 
-  report.scene = scene.name;
-  report.triangles = scene.triangles.size();
-  report.settings = settings;
   report.seconds = std::chrono::duration<double>(t1 - t0).count();
   report.rays = totals.rays;
   report.paths = totals.paths;
@@ -63,7 +59,6 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   report.threads = threads;
   report.tracer_host_bytes =
       film.bytes() + totals.pool_bytes + totals.table_bytes + uint64_t(std::max<int64_t>(0, embree.peak_bytes()));
-  report.peak_host_bytes = peak_resident_bytes();
   report.extra["embree_bytes"] = embree.peak_bytes();
   const LayoutChoice& layout = embree.layout_choice();
   report.extra["embree_layout"] = {{"asked", to_string(settings.embree_layout)},

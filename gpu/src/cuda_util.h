@@ -33,7 +33,6 @@ class DeviceMemory {
   // Starts a new peak measurement: own bytes and the device's free memory now.
   void begin_measurement();
   void sample();  // notes the device's free memory (call after allocations / launches)
-  uint64_t current() const { return current_; }
   uint64_t peak_allocated() const { return peak_; }
   uint64_t peak_meminfo_delta() const { return free_at_begin_ > min_free_ ? free_at_begin_ - min_free_ : 0; }
   static uint64_t free_bytes();
@@ -85,6 +84,19 @@ template <class T> class DeviceBuffer {
  private:
   T* p_ = nullptr;
   uint64_t n_ = 0;
+};
+
+// A stream and an event that are destroyed with their scope (timing brackets, the
+// render's own stream).
+struct ScopedStream {
+  cudaStream_t s = nullptr;
+  ScopedStream() { PB_CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking)); }
+  ~ScopedStream() { if (s) cudaStreamDestroy(s); }
+};
+struct ScopedEvent {
+  cudaEvent_t e = nullptr;
+  ScopedEvent() { PB_CUDA_CHECK(cudaEventCreate(&e)); }
+  ~ScopedEvent() { if (e) cudaEventDestroy(e); }
 };
 
 // The launch wrapper. Every kernel launched through it must begin with pdl_wait()
@@ -142,7 +154,6 @@ class Launcher {
   nlohmann::json collect();
   static std::string format_table(const nlohmann::json& profile);
   void clear();  // forget counts and times (after a warm-up)
-  bool profiling() const { return profile_; }
 
  private:
   struct Stage {

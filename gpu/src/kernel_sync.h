@@ -6,6 +6,8 @@
 //   pdl_trigger(): this grid's dependants may be scheduled now (they wait anyway);
 //   pdl_wait():    block until the previous grid has completed and its memory is
 //                  visible. Before it, a kernel must not read anything produced upstream.
+#include <cstdint>
+
 namespace pb::gpu {
 
 __device__ __forceinline__ void pdl_trigger() {
@@ -25,5 +27,9 @@ __device__ __forceinline__ void kernel_prologue() {
   pdl_trigger();
   pdl_wait();
 }
+
+// Grid-stride loops: this thread's index and the grid's thread count.
+__device__ __forceinline__ uint32_t grid_thread() { return blockIdx.x * blockDim.x + threadIdx.x; }
+__device__ __forceinline__ uint32_t grid_threads() { return gridDim.x * blockDim.x; }
 
 }  // namespace pb::gpu

@@ -18,6 +18,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/run.h"
 #include "ray_cast.h"
 #include "render_binding.h"
 #include "scene_handle.h"

@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "arguments.h"
-#include "device_render.h"  // the render entry: the one call site in the module (below)
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/settings.h"
+#include "pathbench/run/run.h"  // the render entry: the one call site in the module (below)
 #include "scene_handle.h"
 
 namespace pb::python {
@@ -84,16 +84,16 @@ py::tuple render(const SceneHandle& s, const py::object& width, const py::object
   rs.progress = false;
 
   try {
-    apply_choices(c, rs);  // the CLI's parsing and validation
+    apply_choices(c, rs);  // the CLI's parsing (run::render validates)
   } catch (const InputError& e) {
     throw py::value_error(python_terms(e.what()));
   }
-  Film film(rs.width, rs.height, rs.variance);
+  Film film;  // sized and begun by run::render, after it has validated the settings
   RunReport report;
   std::vector<float> mean, var;
   try {
     py::gil_scoped_release release;  // pure C++ from here: no Python object is touched
-    app::render_on_device(s.scene(), rs, film, report, prof);
+    run::render(s.scene(), rs, film, report, {.profile = prof});
     mean = film.mean();
     if (rs.variance) var = film.variance_of_mean();
   } catch (const InputError& e) {  // e.g. device='gpu' in a build without CUDA
@@ -126,7 +126,7 @@ std::string python_terms(const std::string& m) {
 void def_render(py::module_& m) {
   m.def("gpu_available", [] {
     std::string why;
-    const bool yes = app::gpu_available(&why);
+    const bool yes = run::gpu_available(&why);
     return py::make_tuple(yes, why);
   }, "(True, '') when render(device='gpu') can run here, else (False, the reason).");
   m.def("render", &render, py::arg("scene"), py::arg("width"), py::arg("height"), py::arg("spp"), py::kw_only(),

@@ -5,7 +5,7 @@ namespace pb::python {
 const cpu::EmbreeScene& SceneHandle::embree(bool watertight) const {
   std::lock_guard lock(mutex_);
   auto& e = embree_[watertight ? 1 : 0];
-  if (!e) e = std::make_unique<cpu::EmbreeScene>(scene_, watertight, layout_);
+  if (!e) e = cpu::make_embree_scene(scene_, watertight, layout_);
   return *e;
 }
 

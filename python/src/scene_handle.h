@@ -19,7 +19,7 @@ class SceneHandle {
       : scene_(std::move(scene)), layout_(layout) {}
   const Scene& scene() const { return scene_; }
 
-  // The CPU tracer's Embree scene (EmbreeScene(scene, watertight, layout)), built once per flag.
+  // The CPU tracer's Embree scene (make_embree_scene(scene, watertight, layout)), built once per flag.
   const cpu::EmbreeScene& embree(bool watertight) const;
   // The GPU tracer's BVH (build_bvh with its default options), kept on the host.
   const gpu::BvhHost& bvh() const;

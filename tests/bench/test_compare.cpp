@@ -9,14 +9,14 @@
 #include <string>
 #include <sys/wait.h>
 
-#include "compare_command.h"
+#include "pathbench/analysis/bench_compare.h"
 #include "pathbench/common/errors.h"
 
 namespace {
 
-using pb::app::CompareOptions;
-using pb::app::mann_whitney_u;
-using pb::app::run_compare;
+using pb::analysis::CompareOptions;
+using pb::analysis::mann_whitney_u;
+using pb::analysis::run_compare;
 
 const std::string kData = std::string(PATHBENCH_SOURCE_DIR) + "/tests/data/bench/";
 
@@ -31,7 +31,7 @@ int compare(const std::string& base, const std::string& next, double threshold =
 
 // A copy of `in` with every iteration's time (and rays/s inversely) scaled by `f`.
 std::string scaled_copy(const std::string& in, double f, const std::string& name) {
-  nlohmann::json j = pb::app::read_benchmark_json(in);
+  nlohmann::json j = pb::analysis::read_benchmark_json(in);
   for (auto& b : j["benchmarks"]) {
     for (const char* k : {"real_time", "cpu_time"})
       if (b.contains(k)) b[k] = b[k].get<double>() * f;
@@ -45,7 +45,7 @@ std::string scaled_copy(const std::string& in, double f, const std::string& name
 // A copy of `in` with the wall time of every iteration scaled by `f` and its CPU time
 // left as it was: what another process taking the cores does.
 std::string wall_only_copy(const std::string& in, double f, const std::string& name) {
-  nlohmann::json j = pb::app::read_benchmark_json(in);
+  nlohmann::json j = pb::analysis::read_benchmark_json(in);
   for (auto& b : j["benchmarks"])
     if (b.contains("real_time")) b["real_time"] = b["real_time"].get<double>() * f;
   const std::string out = std::string(PATHBENCH_TEST_TMP) + "/" + name;
@@ -117,12 +117,12 @@ TEST(Compare, NoisyButEqualIsNotARegression) {
 }
 
 TEST(Compare, VerdictsPerBenchmark) {
-  auto base = pb::app::load_benchmark_json(kData + "base.json", 9);
-  auto slow = pb::app::load_benchmark_json(kData + "slower10.json", 9);
-  auto rows = pb::app::compare_files(base, slow, 0.05, 0.05);
+  auto base = pb::analysis::load_benchmark_json(kData + "base.json", 9);
+  auto slow = pb::analysis::load_benchmark_json(kData + "slower10.json", 9);
+  auto rows = pb::analysis::compare_files(base, slow, 0.05, 0.05);
   ASSERT_EQ(rows.size(), 3u);
   for (const auto& r : rows) {
-    EXPECT_EQ(r.verdict, pb::app::Verdict::Regressed) << r.name;
+    EXPECT_EQ(r.verdict, pb::analysis::Verdict::Regressed) << r.name;
     EXPECT_NEAR(r.time_change, 0.10, 1e-9) << r.name;
     EXPECT_TRUE(r.has_rays);
     EXPECT_NEAR(r.rays_change, 1 / 1.1 - 1, 1e-9) << r.name;
@@ -165,9 +165,9 @@ TEST(CompareContext, NoCommonNameIsRefused) {
 }
 
 TEST(CompareContext, ZeroTimesAreNotAnImprovement) {
-  auto rows = pb::app::compare_files(pb::app::load_benchmark_json(kData + "base.json", 9),
-                                     pb::app::load_benchmark_json(kData + "zero-times.json", 9), 0.05, 0.05);
-  for (const auto& r : rows) EXPECT_EQ(r.verdict, pb::app::Verdict::Invalid) << r.name;
+  auto rows = pb::analysis::compare_files(pb::analysis::load_benchmark_json(kData + "base.json", 9),
+                                     pb::analysis::load_benchmark_json(kData + "zero-times.json", 9), 0.05, 0.05);
+  for (const auto& r : rows) EXPECT_EQ(r.verdict, pb::analysis::Verdict::Invalid) << r.name;
   EXPECT_EQ(cli(kData + "base.json " + kData + "zero-times.json"), 2);  // nothing left to compare
   EXPECT_EQ(cli(kData + "zero-times.json " + kData + "base.json"), 2);
 }
@@ -194,11 +194,11 @@ TEST(CompareContext, OtherLayoutWarnsAndStrictRefuses) {
 // busy loops beside it. Wall time went up 12-17 fold, CPU time by a sixth to a third:
 // contended, not a regression; --strict refuses the pair.
 TEST(CompareContext, RealContendedRunIsFlaggedContended) {
-  auto rows = pb::app::compare_files(pb::app::load_benchmark_json(kData + "quick-quiet.json", 9),
-                                     pb::app::load_benchmark_json(kData + "quick-contended.json", 9), 0.05, 0.05);
+  auto rows = pb::analysis::compare_files(pb::analysis::load_benchmark_json(kData + "quick-quiet.json", 9),
+                                     pb::analysis::load_benchmark_json(kData + "quick-contended.json", 9), 0.05, 0.05);
   ASSERT_FALSE(rows.empty());
   for (const auto& r : rows) {
-    EXPECT_EQ(r.verdict, pb::app::Verdict::Contended) << r.name;
+    EXPECT_EQ(r.verdict, pb::analysis::Verdict::Contended) << r.name;
     EXPECT_TRUE(r.has_cpu && r.diverges) << r.name;
   }
   std::string out;
@@ -209,16 +209,16 @@ TEST(CompareContext, RealContendedRunIsFlaggedContended) {
 
 TEST(CompareContext, WallUpCpuFlatIsContendedBothUpIsRegression) {
   const std::string real = kData + "quick-9rep.json";
-  auto base = pb::app::load_benchmark_json(real, 9);
-  auto wall = pb::app::load_benchmark_json(wall_only_copy(real, 1.3, "quick-wall-1.3.json"), 9);
-  auto both = pb::app::load_benchmark_json(scaled_copy(real, 1.3, "quick-both-1.3.json"), 9);
+  auto base = pb::analysis::load_benchmark_json(real, 9);
+  auto wall = pb::analysis::load_benchmark_json(wall_only_copy(real, 1.3, "quick-wall-1.3.json"), 9);
+  auto both = pb::analysis::load_benchmark_json(scaled_copy(real, 1.3, "quick-both-1.3.json"), 9);
   // (One real series, occluded1/coherent, is too spread for p < 0.05 at +30%: "same".)
-  const auto by_wall = pb::app::compare_files(base, wall, 0.05, 0.05);
-  const auto by_both = pb::app::compare_files(base, both, 0.05, 0.05);
-  for (const auto& r : by_wall) EXPECT_NE(r.verdict, pb::app::Verdict::Regressed) << r.name;
-  for (const auto& r : by_both) EXPECT_NE(r.verdict, pb::app::Verdict::Contended) << r.name;
-  EXPECT_GE(pb::app::count_verdict(by_wall, pb::app::Verdict::Contended), int(by_wall.size()) - 1);
-  EXPECT_GE(pb::app::count_verdict(by_both, pb::app::Verdict::Regressed), int(by_both.size()) - 1);
+  const auto by_wall = pb::analysis::compare_files(base, wall, 0.05, 0.05);
+  const auto by_both = pb::analysis::compare_files(base, both, 0.05, 0.05);
+  for (const auto& r : by_wall) EXPECT_NE(r.verdict, pb::analysis::Verdict::Regressed) << r.name;
+  for (const auto& r : by_both) EXPECT_NE(r.verdict, pb::analysis::Verdict::Contended) << r.name;
+  EXPECT_GE(pb::analysis::count_verdict(by_wall, pb::analysis::Verdict::Contended), int(by_wall.size()) - 1);
+  EXPECT_GE(pb::analysis::count_verdict(by_both, pb::analysis::Verdict::Regressed), int(by_both.size()) - 1);
 }
 
 TEST(CompareCli, Formats) {

@@ -4,7 +4,7 @@
 #include <fmt/core.h>
 
 #include "fuzz_util.h"
-#include "scene_io.h"
+#include "scene_io/scene_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string input = pb::fuzz::text_of(data, size);

@@ -5,7 +5,7 @@
 
 #include "fuzz_util.h"
 #include "pathbench/common/limits.h"
-#include "scene_io.h"
+#include "scene_io/scene_io.h"
 
 namespace {
 

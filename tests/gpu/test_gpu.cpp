@@ -10,9 +10,9 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/gpu/bvh_build.h"
 #include "pathbench/gpu/render.h"
+#include "pathbench/run/run.h"
 #include "traversal_check.h"
 #if __has_include("../unit/stat_test.h")
 #include "../unit/stat_test.h"
@@ -44,6 +44,7 @@ RenderSettings small_settings(Strategy strategy, uint32_t size = 64, uint32_t sp
 Film render_gpu(const Scene& scene, const GpuScene& gs, RenderSettings s, RunReport* out = nullptr) {
   Film film(s.width, s.height, s.variance);
   RunReport r;
+  film.begin(s.spp, scene.max_emission());  // as the run layer does before it calls the tracer
   render(scene, gs, s, film, r, false);
   EXPECT_EQ(r.paths, s.total_samples());
   EXPECT_EQ(r.discarded_samples, 0u);
@@ -129,10 +130,10 @@ void gpu_vs_cpu(const char* name) {
   s.variance = true;
   Film gpu_film(s.width, s.height, true), cpu_film(s.width, s.height, true);
   RunReport gr, cr;
-  render(scene, s, gpu_film, gr, false);
+  run::render(scene, s, gpu_film, gr);
   RenderSettings sc = s;
   sc.device = Device::Cpu;
-  cpu::render(scene, sc, cpu_film, cr);
+  run::render(scene, sc, cpu_film, cr);
   const auto g = gpu_film.mean(), c = cpu_film.mean();
   size_t within = 0, differ_at_all = 0;
   double worst = 0;
@@ -236,7 +237,7 @@ TEST(PaperQueue, RefusesWhenTheQueueDoesNotFit) {
   Film film(s.width, s.height, false);
   RunReport r;
   try {
-    render(scene, s, film, r, false);
+    run::render(scene, s, film, r);
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
     const std::string msg = e.what();
@@ -252,7 +253,7 @@ TEST(GpuReport, HasDeviceFacts) {
   RenderSettings s = small_settings(Strategy::Wavefront, 32, 8);
   Film film(s.width, s.height, false);
   RunReport r;
-  render(scene, s, film, r, true);
+  run::render(scene, s, film, r, {.profile = true});
   const auto j = r.to_json();
   EXPECT_GT(j["device_seconds"].get<double>(), 0.0);
   EXPECT_GT(j["peak_device_bytes"].get<uint64_t>(), 0u);

@@ -30,7 +30,7 @@ struct Hit {
 // Embree's answers on the same scene, built as the CPU tracer builds it (watertight).
 class EmbreeReference {
  public:
-  explicit EmbreeReference(const Scene& s) : embree_(s, /*watertight=*/true), scene_(embree_.handle()) {}
+  explicit EmbreeReference(const Scene& s) : embree_(cpu::make_embree_scene(s, /*watertight=*/true)), scene_(embree_->handle()) {}
   Hit closest(const Ray3& r) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -40,7 +40,7 @@ class EmbreeReference {
     rtcIntersect1(scene_, &ctx, &rh);
     Hit h;
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-      h.prim = embree_.triangle(rh.hit);
+      h.prim = embree_->triangle(rh.hit);
       h.t = rh.ray.tfar;
     }
     return h;
@@ -65,7 +65,7 @@ class EmbreeReference {
     e.flags = 0;
     e.id = 0;
   }
-  cpu::EmbreeScene embree_;
+  std::unique_ptr<cpu::EmbreeScene> embree_;
   RTCScene scene_;
 };
 

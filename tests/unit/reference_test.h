@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "pathbench/common/image_io.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "stat_test.h"
 
 namespace pb::reftest {
@@ -76,7 +76,7 @@ inline Image render_with_variance(const Scene& scene, RenderSettings s) {
   s.progress = false;
   Film film(s.width, s.height, true);
   RunReport report;
-  cpu::render(scene, s, film, report);
+  run::render(scene, s, film, report);
   EXPECT_EQ(report.discarded_samples, 0u);
   return {film.mean(), film.variance_of_mean(), double(s.spp), report.seconds};
 }

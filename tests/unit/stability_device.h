@@ -12,7 +12,7 @@
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #ifdef PB_STABILITY_ON_GPU
 #include "pathbench/gpu/render.h"
 #endif
@@ -42,19 +42,19 @@ inline Rendered render(const Scene& scene, RenderSettings s) {
   Rendered r{Film(s.width, s.height, s.variance), {}};
 #ifdef PB_STABILITY_ON_GPU
   s.strategy = Strategy::Pixel;
-  gpu::render(scene, s, r.film, r.report, false);
+  run::render(scene, s, r.film, r.report);
   // The wavefront must agree bit for bit, extremes included (it has queues to overflow
   // and counters to wrap that the megakernel has not).
   RenderSettings w = s;
   w.strategy = Strategy::Wavefront;
   Film wf(s.width, s.height, s.variance);
   RunReport wr;
-  gpu::render(scene, w, wf, wr, false);
+  run::render(scene, w, wf, wr);
   EXPECT_TRUE(wf.raw_sums() == r.film.raw_sums()) << "GPU wavefront film differs from pixel's";
   EXPECT_TRUE(wf.counts() == r.film.counts()) << "GPU wavefront sample counts differ from pixel's";
   EXPECT_EQ(wr.discarded_samples, r.report.discarded_samples);
 #else
-  cpu::render(scene, s, r.film, r.report);
+  run::render(scene, s, r.film, r.report);
 #endif
   return r;
 }

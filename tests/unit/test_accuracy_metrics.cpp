@@ -8,11 +8,11 @@
 #include <stdexcept>
 #include <vector>
 
-#include "accuracy_metrics.h"
+#include "pathbench/analysis/accuracy_metrics.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 
-namespace pb::app {
+namespace pb::analysis {
 namespace {
 
 // A reference with varied values (a gradient, some black pixels), RGB.
@@ -116,7 +116,7 @@ TEST(AccuracyMetrics, FurnaceTruncationBiasIsMeasured) {
   s.progress = false;
   Film film(s.width, s.height, true);
   RunReport report;
-  cpu::render(scene, s, film, report);
+  run::render(scene, s, film, report);
   const std::vector<float> exact(film.pixels() * 3, Le / (1 - a));
   const Bias b = relative_bias(film.mean(), film.variance_of_mean(), exact, {});
   EXPECT_NEAR(b.relative, -a * a, 4 * b.std_error + 1e-6);
@@ -134,4 +134,4 @@ TEST(AccuracyMetrics, EfficiencyAndBadInput) {
 }
 
 }  // namespace
-}  // namespace pb::app
+}  // namespace pb::analysis

@@ -12,6 +12,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/common/settings.h"
+#include "pathbench/run/run.h"
 
 namespace pb {
 namespace {
@@ -160,14 +161,21 @@ TEST(Settings, ApplyChoicesParsesEveryNameAndConverged) {
   EXPECT_EQ(s.max_bounces, -1);
   EXPECT_TRUE(s.russian_roulette);
 }
-TEST(BadSettings, ApplyChoicesRefusesWhatParseAndValidateRefuse) {
+TEST(BadSettings, ApplyChoicesRefusesUnknownNames) {
   RenderSettings s;
   RenderChoices c;
   c.precision = "half";
   expect_input_error([&] { apply_choices(c, s); }, {"--precision", "'half'"});
-  c = RenderChoices{};
+}
+// Settings are validated once, by the run layer, before any film is sized.
+TEST(BadSettings, RunRenderValidatesOnce) {
+  RenderSettings s;
   s.spp = 0;
-  expect_input_error([&] { apply_choices(c, s); }, {"--spp"});
+  const Scene scene = load_scene("paper-cornell");
+  Film film(1, 1, false);
+  RunReport report;
+  expect_input_error([&] { run::render(scene, s, film, report); }, {"--spp"});
+  EXPECT_EQ(film.width(), 1u);  // untouched: refused before the film was sized
 }
 
 }  // namespace

@@ -82,7 +82,9 @@ TEST(TrianglePairs, ClosedMeshesPairUpAndLoneTrianglesStayAlone) {
 // same t, for either triangle).
 TEST(EmbreeLayouts, QuadsFindTheTrianglesThatTrianglesFind) {
   for (const Scene& s : {make_paper_cornell(), make_paper_cornell_ico(4)}) {
-    const cpu::EmbreeScene tris(s, true, EmbreeLayout::Triangles), quads(s, true, EmbreeLayout::Quads);
+    const auto tris_scene = cpu::make_embree_scene(s, true, EmbreeLayout::Triangles);
+    const auto quads_scene = cpu::make_embree_scene(s, true, EmbreeLayout::Quads);
+    const cpu::EmbreeScene &tris = *tris_scene, &quads = *quads_scene;
     ASSERT_EQ(tris.layout(), EmbreeLayout::Triangles);
     ASSERT_EQ(quads.layout(), EmbreeLayout::Quads);
     std::mt19937 rng(3);
@@ -134,8 +136,8 @@ TEST(EmbreeLayouts, AutoFollowsItsProbeAndIsRemembered) {
   EXPECT_EQ(b.layout, a.layout);  // remembered: the same numbers, not a second measurement
   EXPECT_EQ(b.triangles_ns, a.triangles_ns);
   EXPECT_EQ(b.quads_ns, a.quads_ns);
-  const cpu::EmbreeScene automatic(s, true);
-  EXPECT_EQ(automatic.layout(), a.layout);
+  const auto automatic = cpu::make_embree_scene(s, true);
+  EXPECT_EQ(automatic->layout(), a.layout);
 
   Scene soup = make_paper_cornell();  // the box plus 20 loose triangles: too few pairs
   for (int k = 0; k < 20; ++k) {

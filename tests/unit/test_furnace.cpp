@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "furnace_check.h"
 
 namespace pb {
@@ -33,7 +33,7 @@ TEST_P(Furnace, MeanMatchesClosedForm) {
   s.progress = false;
   Film film(s.width, s.height, true);
   RunReport report;
-  cpu::render(scene, s, film, report);
+  run::render(scene, s, film, report);
 
   const double expected = furnace_radiance(a, Le, s.max_bounces);
   const auto [measured, sigma] = image_mean(film);

@@ -10,8 +10,8 @@
 #include <functional>
 #include <string>
 
-#include "compare_command.h"
-#include "device_render.h"
+#include "pathbench/analysis/bench_compare.h"
+#include "pathbench/run/run.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
@@ -117,7 +117,7 @@ TEST_F(SpecialFiles, JsonDepthAndKeysAreBounded) {
   for (int i = 0; i <= 10000; ++i) keys += (i ? ",\"k" : "\"k") + std::to_string(i) + "\": 0";
   write("keys.json", keys + "}");
   for (auto load : {std::function<void(const std::string&)>([](const std::string& p) { load_scene(p); }),
-                    std::function<void(const std::string&)>([](const std::string& p) { app::load_benchmark_json(p, 2); })}) {
+                    std::function<void(const std::string&)>([](const std::string& p) { analysis::load_benchmark_json(p, 2); })}) {
     EXPECT_NE(error_of([&] { load(path("deep.json")); }).find("deep.json: JSON nested deeper than 64 levels"),
               std::string::npos);
     EXPECT_NE(error_of([&] { load(path("keys.json")); }).find("keys.json: a JSON object with more than 10000 keys"),
@@ -127,15 +127,15 @@ TEST_F(SpecialFiles, JsonDepthAndKeysAreBounded) {
 
 TEST_F(SpecialFiles, CompareReadsRegularFilesOnly) {
   ASSERT_EQ(::mkfifo(path("fifo.json").c_str(), 0600), 0);
-  EXPECT_NE(error_of([&] { app::load_benchmark_json(path("fifo.json"), 2); })
+  EXPECT_NE(error_of([&] { analysis::load_benchmark_json(path("fifo.json"), 2); })
                 .find("is a FIFO; a benchmark JSON file must be a regular file"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { app::load_benchmark_json(dir_.string(), 2); }).find("is a directory"), std::string::npos);
+  EXPECT_NE(error_of([&] { analysis::load_benchmark_json(dir_.string(), 2); }).find("is a directory"), std::string::npos);
   write("typed.json", R"({"context": {}, "benchmarks": [{"name": 5}]})");
-  EXPECT_NE(error_of([&] { app::load_benchmark_json(path("typed.json"), 2); }).find("not Google Benchmark JSON"),
+  EXPECT_NE(error_of([&] { analysis::load_benchmark_json(path("typed.json"), 2); }).find("not Google Benchmark JSON"),
             std::string::npos);
   write("long.json", R"({"context": {}, "benchmarks": [{"name": ")" + std::string(2000, 'x') + R"("}]})");
-  EXPECT_NE(error_of([&] { app::load_benchmark_json(path("long.json"), 2); })
+  EXPECT_NE(error_of([&] { analysis::load_benchmark_json(path("long.json"), 2); })
                 .find("a benchmark name of 2000 bytes (at most 1024)"),
             std::string::npos);
 }
@@ -180,9 +180,9 @@ TEST(Ranges, MostlyDiscardedRenderFails) {
   s.spp = 2;
   RunReport report;
   report.discarded_samples = 16;  // half: still accepted
-  EXPECT_NO_THROW(app::check_discarded(scene, s, report));
+  EXPECT_NO_THROW(run::check_discarded(scene, s, report));
   report.discarded_samples = 17;
-  EXPECT_NE(error_of([&] { app::check_discarded(scene, s, report); })
+  EXPECT_NE(error_of([&] { run::check_discarded(scene, s, report); })
                 .find("17 of 32 samples (53.1%) were discarded as NaN, infinite or beyond the film's range"),
             std::string::npos);
 }

@@ -23,7 +23,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/features.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "furnace_check.h"
 
 namespace pb {
@@ -36,7 +36,7 @@ ImageMean render_mean(const Scene& scene, RenderSettings s, RunReport* report_ou
   s.progress = false;
   Film film(s.width, s.height, true);
   RunReport report;
-  cpu::render(scene, s, film, report);
+  run::render(scene, s, film, report);
   EXPECT_EQ(report.discarded_samples, 0u) << scene.name;
   if (report_out) *report_out = report;
   return image_mean(film);
@@ -181,12 +181,12 @@ TEST(MaterialsRender, PixelAndWavefrontBitIdentical) {
       s.strategy = Strategy::Pixel;
       Film a(s.width, s.height, false);
       RunReport ra;
-      cpu::render(scene, s, a, ra);
+      run::render(scene, s, a, ra);
       s.strategy = Strategy::Wavefront;
       s.paths_in_flight = 1000;  // many refills
       Film b(s.width, s.height, false);
       RunReport rb;
-      cpu::render(scene, s, b, rb);
+      run::render(scene, s, b, rb);
       EXPECT_TRUE(a.raw_sums() == b.raw_sums()) << name << ", bounces " << bounces;
       EXPECT_TRUE(a.counts() == b.counts()) << name;
       EXPECT_EQ(ra.rays.total(), rb.rays.total()) << name;

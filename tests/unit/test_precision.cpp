@@ -9,7 +9,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "furnace_check.h"
 
 namespace pb {
@@ -32,7 +32,7 @@ Rendering render(Precision precision, Strategy strategy) {
   s.seed = 11;
   s.progress = false;
   Rendering r{Film(s.width, s.height, false), {}};
-  cpu::render(scene, s, r.film, r.report);
+  run::render(scene, s, r.film, r.report);
   return r;
 }
 

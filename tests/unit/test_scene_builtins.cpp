@@ -9,7 +9,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "test_scene_helpers.h"
 
 namespace pb {
@@ -104,7 +104,7 @@ TEST(CornellBox, RendersRedOnTheLeftAndGreenOnTheRight) {
   rs.progress = false;
   Film film(rs.width, rs.height, false);
   RunReport report;
-  cpu::render(s, rs, film, report);
+  run::render(s, rs, film, report);
   const auto img = film.mean();
   auto mean_in_columns = [&](uint32_t x0, uint32_t x1) {
     Vec3d sum{0, 0, 0};

@@ -15,7 +15,7 @@
 
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "furnace_check.h"
 #include "stability_device.h"
 #include "stat_test.h"
@@ -153,7 +153,8 @@ std::vector<float> closest_hit_distances(const Scene& scene, const std::vector<s
   for (const gpu::TraceResult& h : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
     t.push_back(h.prim == gpu::kNoHit ? kMiss : h.t);
 #else
-  const cpu::EmbreeScene embree(scene, /*watertight=*/true, layout);
+  const auto embree_scene = cpu::make_embree_scene(scene, /*watertight=*/true, layout);
+  const cpu::EmbreeScene& embree = *embree_scene;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   for (const auto& [o, d] : rays) {

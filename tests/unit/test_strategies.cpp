@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "pathbench/common/scene_library.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 
 namespace pb {
 namespace {
@@ -25,7 +25,7 @@ struct Rendered {
 Rendered render_cornell(const RenderSettings& s) {
   static const Scene scene = make_paper_cornell();
   Rendered r{Film(s.width, s.height, s.variance), {}};
-  cpu::render(scene, s, r.film, r.report);
+  run::render(scene, s, r.film, r.report);
   return r;
 }
 

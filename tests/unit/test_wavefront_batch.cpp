@@ -17,7 +17,7 @@
 #include "pathbench/common/path.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/isa.h"
-#include "pathbench/cpu/render.h"
+#include "pathbench/run/run.h"
 #include "shade_batch.h"
 
 namespace pb {
@@ -37,7 +37,7 @@ Film render(const Scene& scene, Strategy strategy, int threads, Sampling samplin
   s.progress = false;
   Film film(s.width, s.height, false);
   RunReport report;
-  cpu::render(scene, s, film, report);
+  run::render(scene, s, film, report);
   EXPECT_EQ(report.extra["isa"], isa == Isa::Auto ? to_string(cpu::resolve_isa(isa)) : to_string(isa));
   return film;
 }

@@ -20,13 +20,14 @@ namespace pb {
 // What a sample turns into on the film; the same function on CPU and GPU.
 PB_HD int64_t quantize_radiance(float v, double scale) { return int64_t(std::llrint(double(v) * scale)); }
 
-struct FilmView {
-  int64_t* sum;        // 3 per pixel, fixed point
-  uint32_t* count;     // samples per pixel
-  double* sum_sq;      // 3 per pixel, plain double (variance estimate); null if off
-  double scale;
-  uint32_t width, height;
-};
+// Whether a sample may enter the film: every channel finite and strictly below `limit`
+// (Film::sample_limit()), so that no sum can overflow. The one acceptance test of both
+// tracers: Film::add on the CPU, the GPU's film_add_warp; a rejected sample is counted
+// as discarded.
+PB_HD bool sample_acceptable(Vec3f L, double limit) {
+  return is_finite(L) && double(std::fabs(L.x)) < limit && double(std::fabs(L.y)) < limit &&
+         double(std::fabs(L.z)) < limit;
+}
 
 class Film {
  public:
@@ -46,7 +47,7 @@ class Film {
   // Largest per-pixel sum (2^62); one sample may use at most a quarter of it.
   static constexpr double kMaxSum = 4611686018427387904.0;
   // Every channel of an accepted sample is finite and strictly below this: kMaxSum / 4 /
-  // scale(). The GPU's film applies the same bound.
+  // scale(). The GPU's film applies the same bound (sample_acceptable).
   double sample_limit() const { return limit_; }
 
   uint32_t width() const { return width_; }
@@ -54,7 +55,6 @@ class Film {
   size_t pixels() const { return size_t(width_) * height_; }
   bool has_variance() const { return !sum_sq_.empty(); }
   double scale() const { return scale_; }
-  FilmView view();
   size_t bytes() const;
 
   // Mean radiance per pixel, RGB interleaved, row 0 at the top.
@@ -66,12 +66,9 @@ class Film {
   std::vector<int64_t>& raw_sums() { return sum_; }
   std::vector<uint32_t>& counts() { return count_; }
   std::vector<double>& raw_sum_sq() { return sum_sq_; }
+  const std::vector<double>& raw_sum_sq() const { return sum_sq_; }
 
  private:
-  bool accepts(Vec3f L) const {
-    return is_finite(L) && std::fabs(L.x) < limit_ && std::fabs(L.y) < limit_ && std::fabs(L.z) < limit_;
-  }
-
   uint32_t width_ = 0, height_ = 0;
   double scale_ = 1;
   double limit_ = kMaxSum / 4;  // kMaxSum / 4 / scale_
@@ -84,7 +81,7 @@ class Film {
 // GPU accumulates with atomicAdd of its own).
 #if !defined(__CUDACC__)
 inline bool Film::add(uint32_t pixel, Vec3f L) {
-  if (!accepts(L)) return false;
+  if (!sample_acceptable(L, limit_)) return false;
   int64_t* s = &sum_[size_t(pixel) * 3];
   for (int c = 0; c < 3; ++c) s[c] += quantize_radiance(L[c], scale_);
   ++count_[pixel];
@@ -94,7 +91,7 @@ inline bool Film::add(uint32_t pixel, Vec3f L) {
 }
 
 inline bool Film::add_atomic(uint32_t pixel, Vec3f L) {
-  if (!accepts(L)) return false;
+  if (!sample_acceptable(L, limit_)) return false;
   int64_t* s = &sum_[size_t(pixel) * 3];
   for (int c = 0; c < 3; ++c)
     std::atomic_ref<int64_t>(s[c]).fetch_add(quantize_radiance(L[c], scale_), std::memory_order_relaxed);

@@ -38,7 +38,7 @@ struct RunReport {
   // sections; null: to_json writes the host's machine_fingerprint().
   nlohmann::json fingerprint;
   // Contention evidence: load average and process CPU time against wall time around
-  // the render (pb::app::render_on_device fills it); null when not measured.
+  // the render (pb::run::render fills it); null when not measured.
   nlohmann::json load;
 
   double rays_per_second() const { return seconds > 0 ? double(rays.total()) / seconds : 0; }

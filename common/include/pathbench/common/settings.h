@@ -75,8 +75,9 @@ struct RenderChoices {
   std::string isa = "auto";  // CPU: instruction set of the batched path step
   bool converged = false;  // unbounded paths ended by Russian roulette (max_bounces = -1, rr on)
 };
-// Parses the names into `s`, applies `converged`, then s.validate(). Throws InputError
-// naming the CLI option (--sampling, ...); the Python module renames those to its keywords.
+// Parses the names into `s` and applies `converged`. Throws InputError naming the CLI
+// option (--sampling, ...); the Python module renames those to its keywords. The settings
+// as a whole are validated once, by the run layer (pathbench/run/run.h) before it renders.
 void apply_choices(const RenderChoices& c, RenderSettings& s);
 
 const char* to_string(Sampling s);

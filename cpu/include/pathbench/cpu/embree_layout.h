@@ -12,6 +12,7 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
+#include "pathbench/cpu/triangle_pairs.h"
 
 namespace pb::cpu {
 
@@ -26,6 +27,8 @@ struct LayoutChoice {
 // Probed only when at least 90% of the triangles pair up (else Triangles: unpaired
 // triangles are half-empty quads) and the scene has at most 2^16 triangles (building
 // it twice stays cheap; on paper-cornell-ico:6, 82k triangles, quads were 1-4% slower).
-LayoutChoice choose_embree_layout(const Scene& scene, bool watertight);
+// `pairs`, where given, receives the pairing the probe made (left empty when the answer
+// was remembered or no probe ran), so that the caller need not pair again.
+LayoutChoice choose_embree_layout(const Scene& scene, bool watertight, TrianglePairs* pairs = nullptr);
 
 }  // namespace pb::cpu

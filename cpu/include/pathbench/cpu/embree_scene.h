@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
@@ -17,8 +18,11 @@ namespace pb::cpu {
 
 class EmbreeScene {
  public:
-  // Auto: the layout choose_embree_layout (embree_layout.h) measures to be faster.
-  EmbreeScene(const Scene& scene, bool watertight, EmbreeLayout layout = EmbreeLayout::Auto);
+  // Builds exactly the layout `choice` names (Triangles or Quads, never Auto: resolving
+  // Auto measures, and a constructor should not run a benchmark); `pairs`: the pairing
+  // of the scene's triangles where choice.layout is Quads. make_embree_scene, below,
+  // resolves both.
+  EmbreeScene(const Scene& scene, bool watertight, const LayoutChoice& choice, TrianglePairs pairs = {});
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -42,5 +46,11 @@ class EmbreeScene {
   std::atomic<int64_t> bytes_{0};
   std::atomic<int64_t> peak_bytes_{0};
 };
+
+// The Embree scene of `scene` in the layout asked for. Auto is resolved before the scene
+// is built (choose_embree_layout: measured once per scene per process), and the triangles
+// are paired at most once, shared by the layout probe and the scene.
+std::unique_ptr<EmbreeScene> make_embree_scene(const Scene& scene, bool watertight,
+                                               EmbreeLayout layout = EmbreeLayout::Auto);
 
 }  // namespace pb::cpu

@@ -7,9 +7,11 @@
 
 namespace pb::cpu {
 
-// Renders `scene` with settings.strategy (pixel or wavefront) into `film`, which
-// must have the settings' size; fills `report`. Throws InputError on settings the
-// CPU tracer cannot run (e.g. the paper-queue strategy).
+// Traces `scene` with settings.strategy (pixel or wavefront) into `film`, and fills the
+// CPU's fields of `report`. Called by the run layer (pathbench/run/run.h), which has
+// validated the settings, sized and begun the film, and fills the common report fields
+// (scene, settings, peak memory). Throws InputError on settings the CPU tracer cannot
+// run (e.g. the paper-queue strategy).
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report);
 
 // Default number of paths in flight for the wavefront strategy.

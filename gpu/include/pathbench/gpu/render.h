@@ -49,7 +49,9 @@ class GpuScene {
   std::unique_ptr<Impl> impl_;
 };
 
-// Renders into `film` (its size must match the settings); fills `report`. `profile`
+// Traces into `film` and fills the GPU's fields of `report`. Called by the run layer
+// (pathbench/run/run.h), which has validated the settings, checked the device, sized
+// and begun the film, and fills the common report fields. `profile`
 // prints a per-stage table (name, launches, total ms, share) to stdout and adds it to
 // report.extra["profile"]. Throws InputError for no device, settings the GPU cannot
 // run, or device memory too small for the request (naming the setting to lower).

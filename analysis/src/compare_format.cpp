@@ -4,9 +4,9 @@
 
 #include <algorithm>
 
-#include "compare_command.h"
+#include "pathbench/analysis/bench_compare.h"
 
-namespace pb::app {
+namespace pb::analysis {
 
 namespace {
 
@@ -126,4 +126,4 @@ nlohmann::json format_json(const CompareReport& r) {
           {"verdict", regressed ? "regression" : "no regression"}};
 }
 
-}  // namespace pb::app
+}  // namespace pb::analysis

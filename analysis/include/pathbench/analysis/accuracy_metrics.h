@@ -5,7 +5,7 @@
 // sizes do not match.
 #include <vector>
 
-namespace pb::app {
+namespace pb::analysis {
 
 // Relative MSE's epsilon: (x - ref)^2 / (ref^2 + eps) per pixel-channel. 0.01 keeps
 // black pixels from dominating (as in Rousselle et al. 2011 and most denoising papers).
@@ -43,4 +43,4 @@ inline constexpr double kBiasZThreshold = 4.0;
 // 1 / (relMSE x seconds): work-normalised accuracy; higher is better.
 double efficiency(double rel_mse, double seconds);
 
-}  // namespace pb::app
+}  // namespace pb::analysis

@@ -1,6 +1,6 @@
-// Scene files: JSON scene descriptions (scenes/README.md gives the format) and bare
-// OBJ meshes (with their MTL materials). Every problem with a file is one InputError
-// naming the file and, where there is one, the line or the JSON field.
+// JSON scene descriptions (scenes/README.md gives the format); the OBJ meshes they name
+// are read by obj_scene.cpp. Every problem with a file is one InputError naming the file
+// and, where there is one, the JSON field.
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -15,7 +15,7 @@
 #include "pathbench/common/json_input.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_library.h"
-#include "scene_io.h"
+#include "scene_io/scene_io.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {

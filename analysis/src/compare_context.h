@@ -4,11 +4,11 @@
 // Benchmark's CPU facts for files without a fingerprint), the same build (compiler,
 // flags, libraries), the same settings (preset, threads), the same Embree layout per
 // benchmark (labels "embree_layout=..."), and under similar load.
-#include "compare_command.h"
+#include "pathbench/analysis/bench_compare.h"
 
-namespace pb::app {
+namespace pb::analysis {
 
 // Fills rep.base_run / new_run, rep.warnings and rep.notes.
 void describe_runs(const BenchFile& base, const BenchFile& next, CompareReport& rep);
 
-}  // namespace pb::app
+}  // namespace pb::analysis

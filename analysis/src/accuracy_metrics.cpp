@@ -1,4 +1,4 @@
-#include "accuracy_metrics.h"
+#include "pathbench/analysis/accuracy_metrics.h"
 
 #include <fmt/core.h>
 
@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace pb::app {
+namespace pb::analysis {
 
 namespace {
 void check_sizes(const std::vector<float>& a, const std::vector<float>& ref, const char* what) {
@@ -81,4 +81,4 @@ double efficiency(double rel_mse, double seconds) {
   return d > 0 ? 1.0 / d : std::numeric_limits<double>::infinity();
 }
 
-}  // namespace pb::app
+}  // namespace pb::analysis

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <map>
 
-namespace pb::app {
+namespace pb::analysis {
 
 namespace {
 
@@ -194,4 +194,4 @@ void describe_runs(const BenchFile& base, const BenchFile& next, CompareReport& 
   if (invalid) rep.warnings.push_back(fmt::format("{} benchmark(s) with a zero median time: not compared", invalid));
 }
 
-}  // namespace pb::app
+}  // namespace pb::analysis

@@ -23,7 +23,7 @@
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_library.h"
-#include "scene_io.h"
+#include "scene_io/scene_io.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {

@@ -1,0 +1,50 @@
+// The wavefront and paper-queue strategies' frame loop: schedule, generate, intersect,
+// shade and shadow launched in turn on one stream (no host wait between them), the
+// counters read back every few iterations to see whether the frame is done.
+#include "path_pool.cuh"
+
+#include "wavefront_stages.cuh"
+
+namespace pb::gpu {
+
+FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+                          uint64_t total, FilmDev film, bool variance) {
+  PB_CUDA_CHECK(cudaMemsetAsync(ctr_.get(), 0, sizeof(WaveCounters), stream));
+  const ShadowSoA sh{sh_o_.get(), sh_d_.get(), sh_ct_.get(), sh_L_.get(), sh_d2_.get(), sh_c2_.get()};
+  WaveCounters* ctr = ctr_.get();
+  const uint32_t cap = uint32_t(capacity_);
+  FrameResult r;
+  constexpr int kCheckEvery = 4;  // iterations between looks at the counters
+  for (uint64_t it = 0;; ++it) {
+    const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
+    launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
+    launch.launch("generate", k_wf_generate, 0, g.view, c, cur, ctr, spp);
+    launch.launch("intersect", k_wf_intersect, 0, g.bvh, cur, prim_.get(), ctr);
+    with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
+      constexpr uint32_t K = decltype(kinds)::value;
+      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+    });
+    if (shadows_.records) {
+      if (variance) launch.launch("shadow", k_wf_shadow<true>, 0, g.bvh, sh, next, ctr, film);
+      else launch.launch("shadow", k_wf_shadow<false>, 0, g.bvh, sh, next, ctr, film);
+    }
+    if (it % kCheckEvery == kCheckEvery - 1) {
+      PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
+      PB_CUDA_CHECK(cudaStreamSynchronize(stream));
+      if (host_ctr_->live == 0 && host_ctr_->next_sample >= total) {
+        r.iterations = it + 1;
+        break;
+      }
+    }
+  }
+  // The last schedule booked every iteration; every generated path has ended.
+  r.stats = host_ctr_->stats;
+  r.stats.paths = r.stats.camera;
+  r.state_bytes_per_path = state_bytes(shadows_);
+  r.paths_in_flight = capacity_;
+  r.pool_bytes = capacity_ * state_bytes(shadows_) + sizeof(WaveCounters);
+  return r;
+}
+
+}  // namespace pb::gpu

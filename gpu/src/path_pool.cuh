@@ -1,0 +1,75 @@
+#pragma once
+// The pool of paths in flight that the wavefront and paper-queue strategies share: two
+// compacted state buffers, the hits, the shadow records and the counters in device
+// memory (layouts in wavefront_state.cuh), and the frame loop launching the stages
+// (wavefront_stages.cuh) in path_pool.cu.
+#include <cuda_runtime.h>
+
+#include <cstdint>
+
+#include "cuda_util.h"
+#include "device_film.cuh"
+#include "gpu_scene_impl.cuh"
+#include "strategies.cuh"
+#include "wavefront_state.cuh"
+
+namespace pb::gpu {
+
+class PathPool {
+ public:
+  PathPool(uint64_t capacity, ShadowUse shadows, const char* what, const char* lower)
+      : capacity_(capacity), shadows_(shadows) {
+    for (auto& b : buf_) b.allocate(capacity, what, lower);
+    prim_.allocate(capacity, what, lower);
+    if (shadows.records) {
+      sh_o_.allocate(capacity, what, lower);
+      sh_d_.allocate(capacity, what, lower);
+      sh_ct_.allocate(capacity, what, lower);
+      sh_L_.allocate(capacity, what, lower);
+    }
+    if (shadows.pairs) {
+      sh_d2_.allocate(capacity, what, lower);
+      sh_c2_.allocate(capacity, what, lower);
+    }
+    ctr_.allocate(1, what, lower);
+    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(WaveCounters)));
+  }
+  ~PathPool() { if (host_ctr_) cudaFreeHost(host_ctr_); }
+  PathPool(const PathPool&) = delete;
+  PathPool& operator=(const PathPool&) = delete;
+
+  // Per path: two state buffers (current and next), the hit, and where the settings
+  // trace shadow rays one shadow record (a second ray's 24 bytes where pairs occur).
+  static uint64_t state_bytes(ShadowUse shadows) {
+    return 2 * Buffers::bytes_per_path() + sizeof(uint32_t) +
+           (shadows.records ? 3 * sizeof(float4) + sizeof(float2) : 0) +
+           (shadows.pairs ? sizeof(float4) + sizeof(float2) : 0);
+  }
+
+  // One frame of `total` samples: stages launched until every path has ended.
+  FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+                  uint64_t total, FilmDev film, bool variance);
+
+ private:
+  struct Buffers {
+    DeviceBuffer<float4> o, d, beta, L;
+    void allocate(uint64_t n, const char* what, const char* lower) {
+      o.allocate(n, what, lower);
+      d.allocate(n, what, lower);
+      beta.allocate(n, what, lower);
+      L.allocate(n, what, lower);
+    }
+    PathSoA view() const { return {o.get(), d.get(), beta.get(), L.get()}; }
+    static uint64_t bytes_per_path() { return 4 * sizeof(float4); }
+  };
+  uint64_t capacity_;
+  ShadowUse shadows_;
+  Buffers buf_[2];
+  DeviceBuffer<uint32_t> prim_;
+  DeviceBuffer<float4> sh_o_, sh_d_, sh_L_, sh_d2_;
+  DeviceBuffer<float2> sh_ct_, sh_c2_;
+  DeviceBuffer<WaveCounters> ctr_;
+  WaveCounters* host_ctr_ = nullptr;
+};
+
+}  // namespace pb::gpu

@@ -1,0 +1,117 @@
+// The pixel strategy: one megakernel, one thread per pixel sample (grid-stride over all
+// samples of the frame, a warp taking 32 consecutive samples), the whole path in
+// registers. Samples of one pixel are summed in the warp (exact integer sums) before one
+// atomic per pixel.
+#include <cuda_runtime.h>
+
+#include "device_film.cuh"
+#include "gpu_scene_impl.cuh"
+#include "kernel_sync.h"
+#include "path_step.cuh"
+#include "pathbench/gpu/bvh.h"
+#include "strategies.cuh"
+
+namespace pb::gpu {
+
+namespace {
+
+// One path in registers, in scalar type T (the traversal finds the hit triangle in
+// float either way; surface_hit recomputes the hit in T), with the watertight or the
+// Moeller-Trumbore triangle test.
+template <uint32_t Kinds, class T, bool kWatertight>
+__device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
+                                            uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
+  PathState<T> st;
+  path_begin(s, c, pixel, sample, st);
+  ShadowQuery<T> q;
+  auto occlusion_test = [&](const ShadowQuery<T>& query) {  // query: q, filled just before
+    ++n_shadow;
+    if (!occluded<kWatertight>(bvh, Vec3f(query.ray.o), Vec3f(query.ray.d), 1.0f)) shadow_unoccluded(st, query);
+  };
+  for (;;) {
+    if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
+      if (path_final_query<Kinds>(s, c, st, q)) occlusion_test(q);
+      break;
+    }
+    if (st.depth > 0) ++n_bounce;  // the camera ray is counted per path
+    float t;
+    const uint32_t prim = intersect_closest<kWatertight>(bvh, Vec3f(st.ray.o), Vec3f(st.ray.d), kInf, t);
+    if (prim == kNoHit) break;
+    bool wants_shadow;
+    const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
+    if (wants_shadow) occlusion_test(q);
+    if (ev == PathEvent::Done) break;
+  }
+  return Vec3f(st.L);
+}
+
+
+// The block's ray and path counts, one atomic per counter per block. (Discarded samples
+// are counted where they are rejected, in film_add_warp.)
+__device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths) {
+  __shared__ unsigned long long acc[3];
+  if (threadIdx.x < 3) acc[threadIdx.x] = 0;
+  __syncthreads();
+  bounce = __reduce_add_sync(kFullMask, bounce);
+  shadow = __reduce_add_sync(kFullMask, shadow);
+  paths = __reduce_add_sync(kFullMask, paths);
+  if ((threadIdx.x & 31) == 0) {
+    atomicAdd(&acc[0], bounce);
+    atomicAdd(&acc[1], shadow);
+    atomicAdd(&acc[2], paths);
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    atomicAdd(&stats->bounce, acc[0]);
+    atomicAdd(&stats->shadow, acc[1]);
+    atomicAdd(&stats->paths, acc[2]);
+    atomicAdd(&stats->camera, acc[2]);
+  }
+}
+
+template <bool kVariance, uint32_t Kinds, class T, bool kWatertight>
+__global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
+                                               FilmDev film, Stats* stats) {
+  kernel_prologue();
+  const uint32_t lane = threadIdx.x & 31;
+  const uint64_t warp = (uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
+  const uint64_t warps = (uint64_t(gridDim.x) * blockDim.x) >> 5;
+  uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0;
+  for (uint64_t base = warp * 32; base < total; base += warps * 32) {
+    const uint64_t g = base + lane;
+    const bool valid = g < total;
+    const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
+    Vec3f L{0.0f, 0.0f, 0.0f};
+    if (valid) {
+      L = trace_path<Kinds, T, kWatertight>(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
+      ++n_paths;
+    }
+    film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
+  }
+  block_stats_add(stats, n_bounce, n_shadow, n_paths);
+}
+
+}  // namespace
+
+FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+                      uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
+                      DeviceBuffer<Stats>& stats) {
+  PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
+  // The megakernel compiled for the scene's material kinds (features.h).
+  // In float with the watertight test, or (the accuracy study's variants) in double or
+  // with Moeller-Trumbore.
+  with_features(g.view.material_kinds, [&](auto kinds) {
+    constexpr uint32_t K = decltype(kinds)::value;
+    auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, stats.get()); };
+    if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true>) : go(k_pixel<false, K, double, true>);
+    else if (!watertight) variance ? go(k_pixel<true, K, float, false>) : go(k_pixel<false, K, float, false>);
+    else variance ? go(k_pixel<true, K, float, true>) : go(k_pixel<false, K, float, true>);
+  });
+  FrameResult r;
+  PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, stats.get(), sizeof(Stats), cudaMemcpyDeviceToHost, stream));
+  PB_CUDA_CHECK(cudaStreamSynchronize(stream));
+  r.state_bytes_per_path = 0;  // in registers
+  return r;
+}
+
+}  // namespace pb::gpu

@@ -1,0 +1,169 @@
+#pragma once
+// The wavefront's stage kernels, one per stage: schedule (book the last iteration, plan
+// the refill), generate (camera rays), intersect (closest hit), shade (the shared path
+// step; continuing paths compacted into the next buffer, shadow rays queued) and shadow
+// (occlusion, then radiance to the film or the continuing path). Launched by PathPool
+// (path_pool.cu, the only includer).
+#include <cuda_runtime.h>
+
+#include "device_film.cuh"
+#include "kernel_sync.h"
+#include "path_step.cuh"
+#include "pathbench/gpu/bvh.h"
+#include "wavefront_state.cuh"
+
+namespace pb::gpu {
+namespace {
+
+// One thread: books the last iteration and plans this one's refill.
+__global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint32_t capacity) {
+  kernel_prologue();
+  if (grid_thread() != 0) return;
+  WaveCounters& c = *ctr;
+  const uint32_t cont = c.n_next;  // paths that continued from the last shade
+  c.stats.bounce += cont;
+  c.stats.shadow += c.n_shadow;
+  const unsigned long long remaining = total - c.next_sample;
+  const uint32_t room = capacity - cont;
+  const uint32_t n = uint32_t(remaining < room ? remaining : room);
+  c.gen_count = n;
+  c.gen_dst = cont;
+  c.gen_base = c.next_sample;
+  c.next_sample += n;
+  c.stats.camera += n;
+  c.n_cur = cont + n;
+  c.n_next = 0;
+  c.n_shadow = 0;
+  c.live = c.n_cur;
+}
+
+// New samples after the continuing paths; a warp takes consecutive samples of a pixel,
+// as the pixel strategy does (coherent camera rays).
+__global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const WaveCounters* ctr, uint32_t spp) {
+  kernel_prologue();
+  const uint32_t n = ctr->gen_count, dst = ctr->gen_dst;
+  const unsigned long long base = ctr->gen_base;
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const unsigned long long g = base + i;
+    PathState<float> st;
+    path_begin(s, c, uint32_t(g / spp), uint32_t(g % spp), st);
+    store_path(cur, dst + i, st);
+  }
+}
+
+__global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+  kernel_prologue();
+  const uint32_t n = ctr->n_cur;
+  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
+    const float4 o = cur.o[i], d = cur.d[i];
+    float t;
+    prim[i] = intersect_closest(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
+  }
+}
+
+__device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, const ShadowQuery<float>& q, uint32_t target) {
+  sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
+  sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
+  sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
+}
+
+template <bool kVariance, uint32_t Kinds>
+__global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
+                                                     const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film) {
+  kernel_prologue();
+  const uint32_t n = ctr->n_cur;
+  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
+  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
+    const uint32_t i = base + lane;
+    bool add = false, pair = false;
+    uint32_t pixel = 0;
+    Vec3f L_add{0.0f, 0.0f, 0.0f};
+    if (i < n) {
+      PathState<float> st = load_path(cur, i);
+      const uint32_t h = prim[i];
+      pixel = st.pixel;
+      if (h == kNoHit) {
+        add = true;
+        L_add = st.L;
+      } else {
+        ShadowQuery<float> q, fq;
+        bool wants_shadow;
+        PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+        // The next vertex would be the last: answer it here (trace_path does the same
+        // at the top of its loop), so the path never goes through intersect + shade again.
+        bool final_ray = false;
+        if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
+          final_ray = path_final_query<Kinds>(s, c, st, fq);
+          ev = PathEvent::Done;
+        }
+        uint32_t target = kShadowDone | st.pixel;
+        if (ev == PathEvent::Continue) {
+          const uint32_t j = queue_push(&ctr->n_next);
+          store_path(next, j, st);
+          target = j;
+        }
+        if (wants_shadow || final_ray) {
+          // Light-sampling ray first (shadow_unoccluded's order in trace_path); both
+          // rays of a pair leave from the same origin (the offset hit point).
+          const uint32_t k = queue_push(&ctr->n_shadow);
+          push_shadow(sh, k, wants_shadow ? q : fq, target);
+          pair = wants_shadow && final_ray;
+          if (pair) {
+            sh.d2[k] = make_float4(fq.ray.d.x, fq.ray.d.y, fq.ray.d.z, fq.contribution.x);
+            sh.c2[k] = make_float2(fq.contribution.y, fq.contribution.z);
+          }
+          if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, pair ? 1.0f : 0.0f);
+        } else if (ev == PathEvent::Done) {
+          add = true;
+          L_add = st.L;
+        }
+      }
+    }
+    film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
+    const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
+    if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
+  }
+}
+
+template <bool kVariance>
+__global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
+                                                      FilmDev film) {
+  kernel_prologue();
+  const uint32_t n = ctr->n_shadow;
+  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
+  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
+    const uint32_t i = base + lane;
+    bool add = false;
+    uint32_t pixel = 0;
+    Vec3f L{0.0f, 0.0f, 0.0f};
+    if (i < n) {
+      const float4 o = sh.o[i], d = sh.d[i];
+      const float2 ct = sh.ct[i];
+      const uint32_t target = __float_as_uint(ct.y);
+      const Vec3f origin{o.x, o.y, o.z};
+      const bool visible = !occluded(bvh, origin, {d.x, d.y, d.z}, 1.0f);
+      if (target & kShadowDone) {
+        const float4 l = sh.L[i];
+        L = {l.x, l.y, l.z};
+        if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
+        if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
+          const float4 d2 = sh.d2[i];
+          const float2 c2 = sh.c2[i];
+          if (!occluded(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
+        }
+        add = true;
+        pixel = target & ~kShadowDone;
+      } else if (visible) {
+        float4 Lt = next.L[target];
+        Lt.x = Lt.x + o.w;
+        Lt.y = Lt.y + d.w;
+        Lt.z = Lt.z + ct.x;
+        next.L[target] = Lt;
+      }
+    }
+    film_add_warp<kVariance>(film, add, pixel, L, &ctr->stats.discarded);
+  }
+}
+
+}  // namespace
+}  // namespace pb::gpu

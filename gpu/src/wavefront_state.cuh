@@ -1,0 +1,85 @@
+#pragma once
+// The wavefront's state in device memory (pbrt-v4's wavefront/ split: state here, stages
+// in wavefront_stages.cuh, the pool that owns the memory in path_pool.cu): paths and
+// shadow rays as structures of arrays, the per-frame counters, and the warp-aggregated
+// queue append.
+#include <cuda_runtime.h>
+
+#include <cstdint>
+
+#include "device_film.cuh"
+#include "pathbench/common/path.h"
+
+namespace pb::gpu {
+
+// wavefront and paper-queue: a pool of `capacity` paths in flight as structure of
+// arrays, stage kernels linked by queues. Paths that continue are compacted into the
+// other of two state buffers (warp-aggregated atomic append), new samples are appended
+// after them, so every stage reads its paths contiguously. Each stage kernel loops over
+// a count it reads on the device: the host never waits between stages.
+
+struct PathSoA {
+  float4* o;        // ray origin, bsdf_pdf
+  float4* d;        // ray direction, pixel (bits)
+  float4* beta;     // throughput, depth (bits)
+  float4* L;        // radiance so far, sample (bits)
+};
+
+// Shadow rays of one iteration: a light-sampling ray, or the last vertex's emitter
+// query (path_final_query), or both from the same origin (a "pair"). `target`: index
+// of the continuing path in the next buffer, or kShadowDone | pixel for a path that
+// ended (its radiance is in L; L.w != 0 marks a pair, whose second ray is d2/c2).
+struct ShadowSoA {
+  float4* o;        // origin, contribution.x
+  float4* d;        // direction (unnormalised, to the light point), contribution.y
+  float2* ct;       // contribution.z, target (bits)
+  float4* L;        // radiance of a finished path, pair flag (written and read only for those)
+  float4* d2;       // a pair's second ray: direction, contribution.x
+  float2* c2;       // contribution.y, .z
+};
+constexpr uint32_t kShadowDone = 0x80000000u;  // pixels < 2^31 (RenderSettings::validate)
+
+struct WaveCounters {
+  uint32_t n_cur;      // paths to trace this iteration
+  uint32_t n_next;     // paths continued into the next buffer
+  uint32_t n_shadow;   // shadow rays queued this iteration
+  uint32_t gen_count, gen_dst;
+  uint32_t live;       // == n_cur after scheduling; 0: the frame is done
+  unsigned long long next_sample, gen_base;
+  Stats stats;
+};
+
+
+// Warp-aggregated append: one atomic per warp.
+__device__ __forceinline__ uint32_t queue_push(uint32_t* counter) {
+  const uint32_t mask = __activemask();
+  const uint32_t lane = threadIdx.x & 31;
+  const int leader = __ffs(mask) - 1;
+  uint32_t base = 0;
+  if (int(lane) == leader) base = atomicAdd(counter, uint32_t(__popc(mask)));
+  base = __shfl_sync(mask, base, leader);
+  return base + uint32_t(__popc(mask & ((1u << lane) - 1u)));
+}
+
+__device__ __forceinline__ PathState<float> load_path(const PathSoA& p, uint32_t i) {
+  const float4 o = p.o[i], d = p.d[i], b = p.beta[i], L = p.L[i];
+  PathState<float> st;
+  st.ray.o = {o.x, o.y, o.z};
+  st.bsdf_pdf = o.w;
+  st.ray.d = {d.x, d.y, d.z};
+  st.pixel = __float_as_uint(d.w);
+  st.beta = {b.x, b.y, b.z};
+  st.depth = __float_as_uint(b.w);
+  st.L = {L.x, L.y, L.z};
+  st.sample = __float_as_uint(L.w);
+  return st;
+}
+
+__device__ __forceinline__ void store_path(const PathSoA& p, uint32_t i, const PathState<float>& st) {
+  p.o[i] = make_float4(st.ray.o.x, st.ray.o.y, st.ray.o.z, st.bsdf_pdf);
+  p.d[i] = make_float4(st.ray.d.x, st.ray.d.y, st.ray.d.z, __uint_as_float(st.pixel));
+  p.beta[i] = make_float4(st.beta.x, st.beta.y, st.beta.z, __uint_as_float(st.depth));
+  p.L[i] = make_float4(st.L.x, st.L.y, st.L.z, __uint_as_float(st.sample));
+}
+
+}  // namespace pb::gpu

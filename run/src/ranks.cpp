@@ -1,0 +1,33 @@
+#include "pathbench/run/ranks.h"
+
+#include <stdexcept>
+
+namespace pb::run {
+
+SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp) {
+  if (ranks == 0 || rank >= ranks) throw std::invalid_argument("share_of: rank out of range");
+  const uint32_t base = spp / ranks, extra = spp % ranks;
+  const uint32_t first = rank * base + (rank < extra ? rank : extra);
+  return {first, base + (rank < extra ? 1u : 0u)};
+}
+
+void reduce_film(Film& into, const Film& part) {
+  if (into.width() != part.width() || into.height() != part.height() || into.scale() != part.scale() ||
+      into.has_variance() != part.has_variance())
+    throw std::invalid_argument("reduce_film: the films differ in size, scale or variance");
+  auto& sum = into.raw_sums();
+  const auto& add = part.raw_sums();
+  for (size_t i = 0; i < sum.size(); ++i)
+    if (__builtin_add_overflow(sum[i], add[i], &sum[i])) throw std::overflow_error("reduce_film: a pixel sum overflows");
+  auto& count = into.counts();
+  for (size_t i = 0; i < count.size(); ++i)
+    if (__builtin_add_overflow(count[i], part.counts()[i], &count[i]))
+      throw std::overflow_error("reduce_film: a pixel's sample count overflows");
+  if (into.has_variance()) {
+    auto& sq = into.raw_sum_sq();
+    const auto& sq_add = part.raw_sum_sq();
+    for (size_t i = 0; i < sq.size(); ++i) sq[i] += sq_add[i];
+  }
+}
+
+}  // namespace pb::run

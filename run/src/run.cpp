@@ -1,0 +1,86 @@
+#include "pathbench/run/run.h"
+
+#include <fmt/core.h>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/common/limits.h"
+#include "pathbench/cpu/render.h"
+#include "pathbench/run/run_context.h"
+#if PATHBENCH_HAVE_CUDA
+#include "pathbench/gpu/render.h"
+#endif
+
+namespace pb::run {
+
+bool gpu_available(std::string* why_not) {
+#if PATHBENCH_HAVE_CUDA
+  return pb::gpu::device_available(why_not);
+#else
+  if (why_not) *why_not = "this build has no CUDA tracer (configure with -DPATHBENCH_CUDA=ON and nvcc on PATH)";
+  return false;
+#endif
+}
+
+// A film where most samples were discarded (NaN, infinite, or beyond its fixed-point
+// range) is wrong, not noisy: fail rather than write it. Within the supported emission
+// range this takes extreme geometry (a light 1e-10 from a wall, say).
+void check_discarded(const Scene& scene, const RenderSettings& s, const RunReport& report) {
+  const double samples = double(s.width) * double(s.height) * double(s.spp);
+  const double discarded = double(report.discarded_samples);
+  if (samples > 0 && discarded > limits::kMaxDiscardedFraction * samples)
+    throw InputError(fmt::format("{}: {} of {} samples ({:.1f}%) were discarded as NaN, infinite or beyond the "
+                                 "film's range; the image would be wrong, so none is written (emission is "
+                                 "limited to {:g}; very bright lights very close to surfaces also overflow)",
+                                 scene.name, report.discarded_samples, uint64_t(samples), 100 * discarded / samples,
+                                 limits::kMaxEmission));
+}
+
+void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options) {
+  s.validate();
+  if (s.device == Device::Gpu) {
+    std::string why;
+    if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+  }
+  // A film that keeps variance sums keeps them (the accuracy study asks for them so).
+  const bool variance = s.variance || options.keep_variance || film.has_variance();
+  if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
+    film = Film(s.width, s.height, variance);
+  // Begun for the whole frame's spp: the fixed-point scale every strategy, device and
+  // (later) rank shares.
+  film.begin(s.spp, scene.max_emission());
+  report.scene = scene.name;
+  report.triangles = scene.triangles.size();
+  report.settings = s;
+  const nlohmann::json start = load_sample();
+  if (s.device == Device::Cpu) {
+    cpu::render(scene, s, film, report);
+  } else {
+#if PATHBENCH_HAVE_CUDA
+    gpu::render(scene, s, film, report, options.profile);
+#endif
+  }
+  // The load around the tracer alone (so that a contended run can be told from a slow
+  // one) and the machine it ran on, filled here once for every caller.
+  report.load = load_between(start, load_sample());
+  report.fingerprint = run_fingerprint(s.device == Device::Gpu);
+  report.peak_host_bytes = peak_resident_bytes();
+  check_discarded(scene, s, report);
+}
+
+Rendered render(const Scene& scene, const RenderSettings& settings, const RunOptions& options) {
+  Rendered r;
+  render(scene, settings, r.film, r.report, options);
+  return r;
+}
+
+double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
+
+std::string machine_folder(Device device) {
+#if PATHBENCH_HAVE_CUDA
+  if (device == Device::Gpu) return gpu::device_info().slug;
+#endif
+  (void)device;
+  return machine_slug();
+}
+
+}  // namespace pb::run
