@@ -32,6 +32,12 @@ namespace pb {
   } while (0)
 #endif
 
+#ifdef PB_STABILITY_ON_GPU
+constexpr Device kStabilityDevice = Device::Gpu;
+#else
+constexpr Device kStabilityDevice = Device::Cpu;
+#endif
+
 struct Rendered {
   Film film;
   RunReport report;
@@ -39,6 +45,7 @@ struct Rendered {
 
 inline Rendered render(const Scene& scene, RenderSettings s) {
   s.progress = false;
+  s.device = kStabilityDevice;
   Rendered r{Film(s.width, s.height, s.variance), {}};
 #ifdef PB_STABILITY_ON_GPU
   s.strategy = Strategy::Pixel;
@@ -66,6 +73,7 @@ inline RenderSettings nee_settings(uint32_t size, uint32_t spp, int bounces) {
   s.spp = spp;
   s.max_bounces = bounces;
   s.sampling = Sampling::Nee;
+  s.device = kStabilityDevice;
   return s;
 }
 

@@ -13,6 +13,7 @@
 #include <limits>
 #include <random>
 
+#include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/run/run.h"
@@ -348,14 +349,25 @@ TEST(NonFinite, FilmRefusesNaNAndInfAndCountsNothing) {
 // the film, and the report counts them all. Scene files cannot ask for it any more
 // (finalize refuses emission above limits::kMaxEmission), so the scene is changed
 // after validation, the way a tracer bug could.
-TEST(NonFinite, OverflowingRadianceIsDiscardedAndCounted) {
+// Counted, kept out of the film, and then refused by the run layer (more than half of
+// the samples discarded: the image would be wrong, so the render fails with exit 2).
+TEST(NonFinite, OverflowingRadianceIsDiscardedCountedAndRefused) {
   PB_REQUIRE_DEVICE();
   Scene furnace = make_furnace(0.9f, 1.0f);
   furnace.materials[0].emission = {3e38f, 3e38f, 3e38f};
-  const Rendered r = render(furnace, nee_settings(4, 4, 2));
+  RenderSettings s = nee_settings(4, 4, 2);
+  s.progress = false;
+  Film film;
+  RunReport report;
+  try {
+    run::render(furnace, s, film, report);
+    ADD_FAILURE() << "a render with nearly every sample discarded was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("were discarded"), std::string::npos) << e.what();
+  }
   // Nearly all: a path whose only contribution is the 3e38 it sees first stays finite.
-  EXPECT_GE(r.report.discarded_samples, r.report.paths * 9 / 10);
-  for (float v : r.film.mean()) EXPECT_TRUE(std::isfinite(v));
+  EXPECT_GE(report.discarded_samples, report.paths * 9 / 10);
+  for (float v : film.mean()) EXPECT_TRUE(std::isfinite(v));
 }
 
 }  // namespace
