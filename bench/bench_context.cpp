@@ -8,6 +8,7 @@
 #include <ctime>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <stdexcept>
 
 #include "pathbench/analysis/bench_compare.h"
@@ -20,6 +21,12 @@
 namespace pb::bench {
 
 namespace {
+
+uint64_t fnv1a64(const std::string& text) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ull;
+  return h;
+}
 
 std::string first_line(const char* path) {
   std::ifstream in(path);
@@ -81,15 +88,24 @@ void add_environment_context(const std::string& preset) {
   }
 }
 
-void finish_benchmark_json(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the benchmark output back", path));
-  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  in.close();
+namespace {
+
+// Benchmark name -> film hash, in name order (std::map) so the combined hash does not
+// depend on the order the benchmarks ran in.
+std::map<std::string, std::string>& film_hashes() {
+  static std::map<std::string, std::string> hashes;
+  return hashes;
+}
+
+}  // namespace
+
+void record_film_hash(const std::string& benchmark, const std::string& hash) { film_hashes()[benchmark] = hash; }
+
+std::string strict_benchmark_json(const std::string& raw, const std::string& where) {
   // Google Benchmark writes NaN for the cv of a counter that is always zero (0 / 0);
   // the tolerant parser reads it as null. Duplicate keys collapse on parsing (and no
   // counter of ours is named like one of Google Benchmark's keys).
-  nlohmann::ordered_json doc = analysis::parse_benchmark_json_text(raw, path);
+  nlohmann::ordered_json doc = analysis::parse_benchmark_json_text(raw, where);
   const nlohmann::json end = run::load_sample();
   auto& ctx = doc["context"];
   ctx["machine_id"] = fingerprint()["machine_id"];
@@ -97,7 +113,21 @@ void finish_benchmark_json(const std::string& path) {
   ctx["load_average_at_end"] = first_line("/proc/loadavg");
   if (!run_start().is_null())
     ctx["run"] = nlohmann::ordered_json::parse(run::load_between(run_start(), end).dump());
-  write_text_file(path, doc.dump(2) + "\n");
+  if (!film_hashes().empty()) {
+    std::string all;
+    for (const auto& [name, hash] : film_hashes()) all += name + "=" + hash + "\n";
+    ctx["film_hash"] = fmt::format("fnv1a64:{:016x}", fnv1a64(all));
+    ctx["film_hashes"] = film_hashes();
+  }
+  return doc.dump(2) + "\n";
+}
+
+void finish_benchmark_json(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the benchmark output back", path));
+  const std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  write_text_file(path, strict_benchmark_json(raw, path));
 }
 
 }  // namespace pb::bench

@@ -13,12 +13,14 @@
 //
 // Regression runs: --benchmark_repetitions=9 --benchmark_report_aggregates_only=false
 // --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`. That file is
-// strict JSON with the machine fingerprint (bench_context.h); JSON on stdout
-// (--benchmark_format=json) is Google Benchmark's own, NaN included.
+// strict JSON with the machine fingerprint (bench_context.h); so is the JSON on stdout
+// (--benchmark_format=json), printed once the run has finished.
 #include <benchmark/benchmark.h>
 #include <fmt/core.h>
 
 #include <cstring>
+#include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -140,19 +142,38 @@ int main(int argc, char** argv) {
   // The output file (--benchmark_out=PATH, JSON unless another format is asked for) is
   // rewritten after the run as strict JSON with the fingerprint and the end-of-run load.
   // Read before Initialize, which removes the flags it knows from argv.
-  std::string out_path, out_format = "json";
+  std::string out_path, out_format = "json", display_format = "console";
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string a = args[i];
     if (a.rfind("--benchmark_out=", 0) == 0) out_path = a.substr(16);
     if (a.rfind("--benchmark_out_format=", 0) == 0) out_format = a.substr(23);
+    if (a.rfind("--benchmark_format=", 0) == 0) display_format = a.substr(19);
   }
   int new_argc = int(args.size());
   args.push_back(nullptr);
   benchmark::Initialize(&new_argc, args.data());
   if (benchmark::ReportUnrecognizedArguments(new_argc, args.data())) return 2;
   pb::bench::add_environment_context(preset);
-  benchmark::RunSpecifiedBenchmarks();
+  // --benchmark_format=json: Google Benchmark's JSON reporter writes into a buffer,
+  // printed after the run in the same strict form as the output file.
+  std::ostringstream json_display;
+  benchmark::JSONReporter json_reporter;
+  if (display_format == "json") {
+    json_reporter.SetOutputStream(&json_display);
+    json_reporter.SetErrorStream(&std::cerr);
+    benchmark::RunSpecifiedBenchmarks(&json_reporter);
+  } else {
+    benchmark::RunSpecifiedBenchmarks();
+  }
   benchmark::Shutdown();
+  if (display_format == "json") {
+    try {
+      std::cout << pb::bench::strict_benchmark_json(json_display.str(), "stdout");
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
+      return 1;
+    }
+  }
   if (!out_path.empty() && out_format == "json") {
     try {
       pb::bench::finish_benchmark_json(out_path);

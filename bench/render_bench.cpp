@@ -10,6 +10,7 @@
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/run/run.h"
+#include "bench_context.h"
 #include "scene_cache.h"
 
 namespace pb::bench {
@@ -70,6 +71,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
     cpu_seconds += r.load.value("process_cpu_seconds", 0.0);
     last = r;
   }
+  if (last.extra.contains("film_hash")) record_film_hash(render_benchmark_name(c), last.extra["film_hash"].get<std::string>());
   using benchmark::Counter;
   state.counters["rays_per_second"] = Counter(double(rays), Counter::kIsRate);
   state.counters["paths_per_second"] = Counter(double(paths), Counter::kIsRate);

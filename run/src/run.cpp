@@ -5,6 +5,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/cpu/render.h"
+#include "pathbench/run/film_hash.h"
 #include "pathbench/run/run_context.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/render.h"
@@ -65,6 +66,8 @@ void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& 
   report.fingerprint = run_fingerprint(s.device == Device::Gpu);
   report.peak_host_bytes = peak_resident_bytes();
   check_discarded(scene, s, report);
+  // The image's checksum beside its speed (the history stores both in one row).
+  report.extra["film_hash"] = film_hash(film);
 }
 
 Rendered render(const Scene& scene, const RenderSettings& settings, const RunOptions& options) {

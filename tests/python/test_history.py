@@ -299,3 +299,23 @@ def test_instruction_counts_report_every_exact_step(tmp_path):
     assert "regression: callgrind/x/instructions" in r.stderr
     otava = json.loads(hist("changes", "--db", db, "--json", "--otava-only", check=0).stdout)
     assert otava and all(c["method"] == "otava" for c in otava)
+
+
+PATHBENCH = ROOT / "build" / "bin" / "pathbench"
+
+
+@pytest.mark.skipif(not PATHBENCH.exists(), reason="needs build/bin/pathbench")
+def test_real_render_reports_record_their_film_hash(tmp_path):
+    """Speed and correctness in one row: two real renders of one image (pixel and
+    wavefront, bit-identical films) record one film hash; another spp another."""
+    db = tmp_path / "h.sqlite"
+    hashes = {}
+    for i, (strategy, spp) in enumerate((("pixel", 2), ("wavefront", 2), ("pixel", 3))):
+        report = tmp_path / f"r{i}.json"
+        subprocess.run([str(PATHBENCH), "render", "--scene", "paper-cornell", "--width", "16", "--height", "16",
+                        "--spp", str(spp), "--strategy", strategy, "--quiet", "--report", str(report)], check=True)
+        hashes[i] = json.loads(report.read_text())["film_hash"]
+        hist("record", "--db", db, "--export", "", "--commit", f"{i:040x}", report, check=0)
+    stored = [h for (h,) in rows(db, "SELECT film_hash FROM runs ORDER BY id")]
+    assert stored == [hashes[0], hashes[1], hashes[2]]
+    assert hashes[0] == hashes[1] != hashes[2] and hashes[0].startswith("fnv1a64:")
