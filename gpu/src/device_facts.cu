@@ -106,6 +106,22 @@ bool device_available(std::string* why_not) {
   return answer.first;
 }
 
+int device_count() {
+  if (!device_available()) return 0;
+  int n = 0;
+  PB_CUDA_CHECK(cudaGetDeviceCount(&n));
+  return n;
+}
+
+int select_device(int local_rank) {
+  ensure_device();
+  int n = 0;
+  PB_CUDA_CHECK(cudaGetDeviceCount(&n));
+  const int device = (local_rank < 0 ? 0 : local_rank) % n;
+  PB_CUDA_CHECK(cudaSetDevice(device));
+  return device;
+}
+
 DeviceInfo device_info() {
   ensure_device();
   DeviceInfo info;

@@ -1,6 +1,10 @@
 #include "pathbench/run/ranks.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include "pathbench/run/world.h"
 
 namespace pb::run {
 
@@ -28,6 +32,18 @@ void reduce_film(Film& into, const Film& part) {
     const auto& sq_add = part.raw_sum_sq();
     for (size_t i = 0; i < sq.size(); ++i) sq[i] += sq_add[i];
   }
+}
+
+uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, double total_rate) {
+  if (remaining == 0) return 0;
+  // Small enough for a fair tail, large enough that a GPU's per-call cost (warm-up
+  // frame, film copy) stays a small part of a chunk.
+  const uint32_t smallest = std::max<uint32_t>(1, spp / (32u * uint32_t(std::max(ranks, 1))));
+  // Not measured yet: a probe of the smallest size. Then about half of what is left,
+  // shared by rate: rank r's chunk ends when about half of the frame's remaining time has
+  // passed, whoever r is, so all ranks finish close together.
+  const double want = rate > 0 && total_rate > 0 ? std::ceil(0.5 * double(remaining) * rate / total_rate) : 0.0;
+  return uint32_t(std::min<double>(std::max<double>(want, smallest), remaining));
 }
 
 }  // namespace pb::run
