@@ -41,7 +41,9 @@ struct SampleDispenser::Impl {
     for (double r : rates)
       if (r > 0) known += r, ++measured;
     const double total = measured ? known * double(rates.size()) / double(measured) : 0;
-    const uint32_t count = chunk_size(spp - next, spp, world.size(), rates[size_t(rank)], total);
+    // One rank (no mpirun): the whole frame at once, as the one-rank build does.
+    const uint32_t count = world.size() == 1 ? spp - next
+                                             : chunk_size(spp - next, spp, world.size(), rates[size_t(rank)], total);
     const SampleShare s{next, count};
     next += count;
     if (count) ++chunks;
