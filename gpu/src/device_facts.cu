@@ -106,17 +106,20 @@ bool device_available(std::string* why_not) {
   return answer.first;
 }
 
+// Neither creates a context on device 0 (the probe of device_available does): an MPI
+// rank picks its device first, so that 8 ranks do not all hold a context on GPU 0.
 int device_count() {
-  if (!device_available()) return 0;
   int n = 0;
-  PB_CUDA_CHECK(cudaGetDeviceCount(&n));
+  if (cudaGetDeviceCount(&n) != cudaSuccess) {
+    (void)cudaGetLastError();
+    return 0;
+  }
   return n;
 }
 
 int select_device(int local_rank) {
-  ensure_device();
-  int n = 0;
-  PB_CUDA_CHECK(cudaGetDeviceCount(&n));
+  const int n = device_count();
+  if (n == 0) return -1;  // device_available() says why
   const int device = (local_rank < 0 ? 0 : local_rank) % n;
   PB_CUDA_CHECK(cudaSetDevice(device));
   return device;

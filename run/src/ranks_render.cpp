@@ -58,7 +58,7 @@ int cpu_share(const std::vector<std::string>& local_devices) {
 
 int gpu_count() {
 #if PATHBENCH_HAVE_CUDA
-  return gpu_available() ? gpu::device_count() : 0;
+  return gpu::device_count();  // no context yet: the rank has not picked its GPU
 #else
   return 0;
 #endif
@@ -131,7 +131,8 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   int gpu_index = -1;
   on_every_rank([&] {
 #if PATHBENCH_HAVE_CUDA
-    if (s.device == Device::Gpu && gpu_available()) gpu_index = gpu::select_device(w.local_rank());
+    // Before any other CUDA call (RankTracer's device check), so the rank's context is on its GPU.
+    if (s.device == Device::Gpu) gpu_index = gpu::select_device(w.local_rank());
 #endif
     if (s.device == Device::Cpu && s.threads == 0) s.threads = cpu_share(local_devices);
     tracer = std::make_unique<RankTracer>(scene, s, options);
