@@ -35,15 +35,15 @@ void reduce_film(Film& into, const Film& part) {
 }
 
 uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, double total_rate) {
+  (void)spp, (void)ranks;
   if (remaining == 0) return 0;
-  // Small enough for a fair tail, large enough that a GPU's per-call cost (warm-up
-  // frame, film copy) stays a small part of a chunk.
-  const uint32_t smallest = std::max<uint32_t>(1, spp / (32u * uint32_t(std::max(ranks, 1))));
-  // Not measured yet: a probe of the smallest size. Then about half of what is left,
-  // shared by rate: rank r's chunk ends when about half of the frame's remaining time has
-  // passed, whoever r is, so all ranks finish close together.
-  const double want = rate > 0 && total_rate > 0 ? std::ceil(0.5 * double(remaining) * rate / total_rate) : 0.0;
-  return uint32_t(std::min<double>(std::max<double>(want, smallest), remaining));
+  // Not measured yet: a probe of one sample per pixel (a CPU rank's first chunk must not
+  // outlast a GPU's whole frame). Then 3/4 of what is left, shared by rate: every rank's
+  // chunk ends after about 3/4 of the frame's remaining time, whoever it is, so ranks
+  // finish close together and a fast rank needs few chunks (each GPU call costs a
+  // warm-up frame and a film copy): about log4(spp) of them.
+  const double want = rate > 0 && total_rate > 0 ? std::ceil(0.75 * double(remaining) * rate / total_rate) : 1.0;
+  return uint32_t(std::min<double>(std::max(want, 1.0), remaining));
 }
 
 }  // namespace pb::run

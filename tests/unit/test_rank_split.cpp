@@ -71,25 +71,30 @@ TEST(RankSplit, RangeOutsideTheFrameIsABug) {
 }
 
 TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
-  // Unmeasured: the smallest chunk (spp / (32 ranks), at least 1).
-  EXPECT_EQ(run::chunk_size(1024, 1024, 2, 0, 0), 16u);
-  // A rank with 3/4 of the total rate gets 3/8 of what is left.
-  EXPECT_EQ(run::chunk_size(800, 1024, 2, 3.0, 4.0), 300u);
-  // Never more than is left, never less than the smallest (unless less is left).
-  EXPECT_EQ(run::chunk_size(5, 1024, 2, 1.0, 100.0), 5u);
-  EXPECT_EQ(run::chunk_size(500, 1024, 2, 1.0, 100.0), 16u);
+  // Unmeasured: a probe of one sample per pixel.
+  EXPECT_EQ(run::chunk_size(1024, 1024, 2, 0, 0), 1u);
+  // A rank with 3/4 of the total rate gets 3/4 x 3/4 of what is left.
+  EXPECT_EQ(run::chunk_size(800, 1024, 2, 3.0, 4.0), 450u);
+  // Never more than is left, never less than one.
+  EXPECT_EQ(run::chunk_size(5, 1024, 2, 100.0, 100.0), 4u);
+  EXPECT_EQ(run::chunk_size(500, 1024, 2, 1.0, 1000.0), 1u);
   EXPECT_EQ(run::chunk_size(0, 1024, 2, 1.0, 1.0), 0u);
-  // A GPU 30x a CPU: handing out chunks in turn covers the frame exactly.
-  uint32_t next = 0, chunks = 0;
+  // A GPU 30x a CPU, each asking when its chunk would end: the frame is covered exactly,
+  // the GPU needs few chunks, and the CPU's work ends no later than the GPU's.
   const double rate[2] = {30.0, 1.0};
-  while (next < 800) {
-    const uint32_t c = run::chunk_size(800 - next, 800, 2, rate[chunks % 2], 31.0);
+  double busy_until[2] = {0, 0};
+  uint32_t next = 0, chunks[2] = {0, 0};
+  while (next < 1024) {
+    const int r = busy_until[0] <= busy_until[1] ? 0 : 1;
+    const uint32_t c = run::chunk_size(1024 - next, 1024, 2, rate[r], 31.0);
     ASSERT_GT(c, 0u);
     next += c;
-    ++chunks;
+    busy_until[r] += c / rate[r];
+    ++chunks[r];
   }
-  EXPECT_EQ(next, 800u);
-  EXPECT_LT(chunks, 40u);
+  EXPECT_EQ(next, 1024u);
+  EXPECT_LE(chunks[0], 12u);
+  EXPECT_LE(busy_until[1], busy_until[0] * 1.05);
 }
 
 TEST(RankSplit, OneProcessIsOneRank) {

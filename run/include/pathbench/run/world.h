@@ -80,9 +80,8 @@ class World {
 // Dynamic balancing: ranks take chunks of samples ([first, first + count) of every
 // pixel) from one counter held by rank 0, which answers the other ranks from a thread of
 // its own while it renders. A chunk's size follows the asking rank's measured rate (its
-// samples per pixel per second), so a GPU and a CPU rank finish together: each grant is
-// about half the remaining work times the rank's share of the total rate. Collective
-// construction and finish(); next() and abort() are per rank.
+// samples per pixel per second), so a GPU and a CPU rank finish together (chunk_size).
+// Every rank constructs it and calls finish(); next() and abort() are per rank.
 class SampleDispenser {
  public:
   SampleDispenser(World& world, uint32_t spp);
