@@ -7,6 +7,7 @@
 # failing_rank    rank 1 cannot read its scene: every rank ends, exit 2, rank 1's message
 # hybrid_no_gpu   --device hybrid where no GPU can run: exit 2, the GPU rank's message
 # killed_rank     rank 1 SIGKILLed mid-render: the run ends within 30 s, non-zero, no image
+# accuracy        `accuracy --quick`: the ranks' reference equals the one-process reference
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -73,6 +74,14 @@ case $case_name in
     [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
     grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
     refused "$status" "." x.pfm ;;
+  accuracy)
+    "$pb" accuracy --quick --no-report-tool --out-dir one >one.log 2>&1 || { cat one.log >&2; fail "one process failed"; }
+    run -np 2 "$pb" accuracy --quick --no-report-tool --out-dir two
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    for f in one/reference-*.pfm; do
+      cmp -s "$f" "two/${f#one/}" || fail "two/${f#one/} differs from the one-process reference"
+    done
+    grep -q '"parallel_efficiency"' two/reference-*.json || fail "the reference's report has no ranks section" ;;
   *) fail "unknown case" ;;
 esac
 echo "ranks.sh $case_name: ok"
