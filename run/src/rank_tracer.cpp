@@ -43,12 +43,19 @@ void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
     cpu::render(scene_, s, film, chunk);  // Film::add accumulates into the rank's film
   } else {
 #if PATHBENCH_HAVE_CUDA
-    if (scratch_.width() != film.width() || scratch_.height() != film.height() ||
-        scratch_.has_variance() != film.has_variance())
-      scratch_ = Film(film.width(), film.height(), film.has_variance());
-    scratch_.begin(s.spp, scene_.max_emission());  // zeroed, the frame's scale
-    gpu::render(scene_, gpu_->scene, s, scratch_, chunk, options_.profile);
-    reduce_film(film, scratch_);
+    // The device's film comes back whole, replacing the host's: the first chunk lands in
+    // the rank's film (begun, so zero), later ones in a scratch film added to it. A static
+    // split (one chunk) thus costs no extra copy or addition.
+    if (chunks_ == 0) {
+      gpu::render(scene_, gpu_->scene, s, film, chunk, options_.profile);
+    } else {
+      if (scratch_.width() != film.width() || scratch_.height() != film.height() ||
+          scratch_.has_variance() != film.has_variance())
+        scratch_ = Film(film.width(), film.height(), film.has_variance());
+      scratch_.begin(s.spp, scene_.max_emission());  // zeroed, the frame's scale
+      gpu::render(scene_, gpu_->scene, s, scratch_, chunk, options_.profile);
+      reduce_film(film, scratch_);
+    }
 #endif
   }
   // The first chunk's description (device, memory, layout) stands for the rank's;

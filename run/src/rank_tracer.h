@@ -18,15 +18,16 @@ class RankTracer {
   // Throws InputError like run::render.
   RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options);
   ~RankTracer();
-  // Traces samples `share` of every pixel into `film` (begun for the whole frame), and
-  // adds the chunk's rays, paths, discarded samples and times into `report`.
+  // Traces samples `share` of every pixel into `film` (begun for the whole frame, and
+  // holding nothing but this tracer's earlier chunks), and adds the chunk's rays, paths,
+  // discarded samples and times into `report`.
   void trace(SampleShare share, Film& film, RunReport& report);
 
  private:
   const Scene& scene_;
   RenderSettings settings_;
   RunOptions options_;
-  Film scratch_;  // GPU: the device's film comes back whole, so each chunk lands here first
+  Film scratch_;  // GPU: the device's film comes back whole, so later chunks land here first
   struct Gpu;
   std::unique_ptr<Gpu> gpu_;
   int chunks_ = 0;
