@@ -49,10 +49,12 @@ void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
     if (chunks_ == 0) {
       gpu::render(scene_, gpu_->scene, s, film, chunk, options_.profile);
     } else {
+      // Begun once, for the frame's scale: every download replaces all its sums and counts.
       if (scratch_.width() != film.width() || scratch_.height() != film.height() ||
-          scratch_.has_variance() != film.has_variance())
+          scratch_.has_variance() != film.has_variance()) {
         scratch_ = Film(film.width(), film.height(), film.has_variance());
-      scratch_.begin(s.spp, scene_.max_emission());  // zeroed, the frame's scale
+        scratch_.begin(s.spp, scene_.max_emission());
+      }
       gpu::render(scene_, gpu_->scene, s, scratch_, chunk, options_.profile);
       reduce_film(film, scratch_);
     }
