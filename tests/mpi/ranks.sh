@@ -8,6 +8,8 @@
 # hybrid_no_gpu   --device hybrid where no GPU can run: exit 2, the GPU rank's message
 # killed_rank     rank 1 SIGKILLed mid-render: the run ends within 30 s, non-zero, no image
 # accuracy        `accuracy --quick`: the ranks' reference equals the one-process reference
+# gpu2, hybrid    (CUDA builds; skipped, status 77, without a usable GPU) 2 GPU ranks, and
+#                 --device hybrid (GPU + CPU ranks, dynamic), give the one-GPU image
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -82,6 +84,12 @@ case $case_name in
       cmp -s "$f" "two/${f#one/}" || fail "two/${f#one/} differs from the one-process reference"
     done
     grep -q '"parallel_efficiency"' two/reference-*.json || fail "the reference's report has no ranks section" ;;
+  gpu2|hybrid)
+    "$pb" $frame --device gpu --out gpu.pfm 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
+    if [ $case_name = gpu2 ]; then run -np 2 "$pb" $frame --device gpu --out x.pfm
+    else run -np 2 "$pb" $frame --device hybrid --out x.pfm --report x.json; fi
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    cmp -s gpu.pfm x.pfm || fail "x.pfm differs from the one-GPU image" ;;
   *) fail "unknown case" ;;
 esac
 echo "ranks.sh $case_name: ok"
