@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "accuracy_reference.h"
+#include "pathbench/run/world.h"
 #include "cli_checks.h"
 #include "pathbench/analysis/accuracy_metrics.h"
 #include "pathbench/common/output_file.h"
@@ -221,6 +222,7 @@ int run_accuracy(AccuracyOptions& o) {
              to_string(base.device), configs.size(), dir);
   const auto t_ref = std::chrono::steady_clock::now();
   const Reference ref = load_or_render_reference(scene, base, o.reference_spp, dir, o.regenerate_reference, true);
+  if (!run::World::get().root()) return 0;  // MPI: the ranks rendered the reference; the sweep is rank 0's
   const double floor = rel_mse_floor(ref.mean, ref.var);
   out["reference"] = ref.info;
   out["reference"]["spp"] = o.reference_spp;

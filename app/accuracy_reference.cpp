@@ -11,7 +11,9 @@
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/report.h"
+#include "pathbench/run/ranks_render.h"
 #include "pathbench/run/run.h"
+#include "pathbench/run/world.h"
 
 namespace pb::app {
 
@@ -44,12 +46,17 @@ bool try_load(const std::string& dir, const std::string& stem, const RenderSetti
 }  // namespace
 
 bool render_unless_gpu_refuses(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report,
-                               std::string& refusal) {
+                               std::string& refusal, bool all_ranks) {
   try {
-    run::render(scene, s, film, report);
+    if (all_ranks) run::render_ranks(scene, s, film, report);
+    else run::render(scene, s, film, report);
     return true;
   } catch (const InputError& e) {
     if (s.device != Device::Gpu) throw;
+    refusal = e.what();
+    return false;
+  } catch (const run::PeerFailure& e) {  // another rank's GPU refused (rank 0 has the message)
+    if (s.device != Device::Gpu || e.code != kExitBadInput) throw;
     refusal = e.what();
     return false;
   }
@@ -74,18 +81,23 @@ Reference load_or_render_reference(const Scene& scene, const RenderSettings& bas
   s.progress = progress;
   const std::string stem = stem_of(scene, s);
   Reference ref;
-  if (!regenerate && try_load(dir, stem, s, ref)) return ref;
+  run::World& world = run::World::get();
+  bool cached = !regenerate && try_load(dir, stem, s, ref);
+  if (world.size() > 1) cached = world.all(cached ? "cached" : "")[0] == "cached";  // rank 0's cache decides
+  if (cached) return ref;
 
   Film film(s.width, s.height, true);
   RunReport report;
   std::string refusal;
-  if (!render_unless_gpu_refuses(scene, s, film, report, refusal)) {
+  if (!render_unless_gpu_refuses(scene, s, film, report, refusal, true)) {
     // A GPU tracer without double precision: the best it has.
-    fmt::print(stderr, "accuracy: reference in double refused by the GPU ({}); rendering it in float\n", refusal);
+    if (world.root())
+      fmt::print(stderr, "accuracy: reference in double refused by the GPU ({}); rendering it in float\n", refusal);
     s.precision = Precision::Float;
     film = Film(s.width, s.height, true);
-    run::render(scene, s, film, report);
+    run::render_ranks(scene, s, film, report);
   }
+  if (!world.root()) return ref;  // rank 0 holds the reference
   ref.mean = film.mean();
   ref.var = film.variance_of_mean();
   fs::create_directories(dir);

@@ -13,6 +13,7 @@
 #include "history_command.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/output_file.h"
+#include "pathbench/run/world.h"
 #include "render_command.h"
 #include "reproduce_command.h"
 
@@ -55,12 +56,17 @@ int main(int argc, char** argv) {
   // From here on output files are being written: a fatal signal removes their
   // temporary files (exit by the signal, 128 + its number in the shell).
   pb::install_output_signal_cleanup();
+  // MPI ranks (run/world.h): the run ends on every rank through World::end, which
+  // finalizes MPI or, for a failure only this rank knows of, aborts every rank.
+  return pb::run::World::end([&] {
   try {
     if (render_cmd->parsed()) return pb::app::run_render(render);
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
     if (compare_cmd->parsed()) return pb::app::run_compare(compare);
     if (accuracy_cmd->parsed()) return pb::app::run_accuracy(accuracy);
     if (bench_cmd->parsed()) return pb::app::run_bench(bench, bench_cmd->remaining());
+  } catch (const pb::run::PeerFailure& e) {
+    return e.code;  // another rank failed; rank 0 printed its message
   } catch (const pb::InputError& e) {
     fmt::print(stderr, "pathbench: error: {}\n", e.what());
     return pb::kExitBadInput;
@@ -69,4 +75,5 @@ int main(int argc, char** argv) {
     return pb::kExitFailed;
   }
   return 0;
+  }());
 }

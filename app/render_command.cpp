@@ -12,6 +12,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/ranks_render.h"
 #include "pathbench/run/run.h"
 
 namespace pb::app {
@@ -37,7 +38,14 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
                  "same image with each")
       ->capture_default_str();
   cmd.add_option("--sampling", o.choices.sampling, "uniform (the paper), cosine, or nee (light sampling + MIS)")->capture_default_str();
-  cmd.add_option("--device", o.choices.device, "cpu or gpu")->capture_default_str();
+  cmd.add_option("--device", o.choices.device,
+                 "cpu, gpu, or hybrid (MPI ranks: GPU ranks on the visible GPUs, CPU ranks on the other cores)")
+      ->capture_default_str();
+  cmd.add_option("--balance", o.balance,
+                 "MPI ranks: static (equal shares), dynamic (chunks from a shared counter), or auto (dynamic "
+                 "when the ranks' devices differ)")
+      ->check(CLI::IsMember({"auto", "static", "dynamic"}))
+      ->capture_default_str();
   cmd.add_option("--strategy", o.choices.strategy, "pixel, wavefront, or paper-queue (GPU)")->capture_default_str();
   cmd.add_option("--paths-in-flight", o.settings.paths_in_flight,
                  "wavefront pool size (0: device default; at most the frame's samples)")
@@ -54,6 +62,7 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
 void finish_render_options(RenderOptions& o) {
   o.settings.variance = !o.variance_out.empty();
   o.settings.progress = !o.quiet;
+  o.choices.device = run::rank_device(o.choices.device);  // --device hybrid: this MPI rank's device
   apply_choices(o.choices, o.settings);
   for (const std::string* path : {&o.out, &o.variance_out}) {
     if (path->empty()) continue;
@@ -82,11 +91,22 @@ void finish_render_options(RenderOptions& o) {
 }
 
 int run_render(RenderOptions& o) {
-  finish_render_options(o);
-  const Scene scene = load_scene(o.scene);
-  Film film;  // sized and begun by run::render, after it has validated the settings
+  // Under mpirun every rank checks its options and loads the scene, and all stop when one fails.
+  Scene scene;
+  run::on_every_rank([&] {
+    finish_render_options(o);
+    scene = load_scene(o.scene);
+  });
+  Film film;  // sized and begun by the run layer, after it has validated the settings
   RunReport report;
-  run::render(scene, o.settings, film, report, {.profile = o.profile});
+  const run::Balance balance = o.balance == "static"    ? run::Balance::Static
+                               : o.balance == "dynamic" ? run::Balance::Dynamic
+                                                        : run::Balance::Auto;
+  // The options besides the settings that every MPI rank must share (MPMD lines).
+  const std::string key = fmt::format("out={} variance_out={} report={} profile={} quiet={} balance={}", o.out,
+                                      o.variance_out, o.report, o.profile, o.quiet, o.balance);
+  // Rank 0 (or the only process) holds the frame; other ranks have given it their samples.
+  if (!run::render_ranks(scene, o.settings, film, report, {.profile = o.profile, .balance = balance}, key)) return 0;
 
   // Each output goes to its own temporary file; only when all are complete are they
   // renamed into place, so a failure (a full disk) leaves none of them.

@@ -19,6 +19,7 @@ struct RenderOptions {
   std::string out, report, variance_out;
   bool profile = false;
   bool quiet = false;
+  std::string balance = "auto";  // MPI ranks: auto, static, dynamic (run::Balance)
 };
 
 void add_render_options(CLI::App& cmd, RenderOptions& o);

@@ -13,7 +13,8 @@ apt_pkgs=(build-essential cmake ninja-build ccache pkg-config git python3 python
           python3-dev  # the `pathbench` Python module (python/; pybind11 from PyPI: tools/requirements.txt)
           libllvm19  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison
           clang libfuzzer-14-dev  # the fuzz targets (scripts/fuzz.sh): libFuzzer + ASan + UBSan
-          valgrind chromium)  # history: instruction counts; the dashboard's headless-browser test
+          valgrind chromium  # history: instruction counts; the dashboard's headless-browser test
+          openmpi-bin libopenmpi-dev)  # MPI ranks (PATHBENCH_MPI, issue 13): mpirun and mpicxx
 missing=()
 for p in "${apt_pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

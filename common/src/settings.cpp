@@ -1,5 +1,7 @@
 #include "pathbench/common/settings.h"
 
+#include <stdexcept>
+
 #include <fmt/core.h>
 
 #include "pathbench/common/errors.h"
@@ -102,6 +104,10 @@ void RenderSettings::validate() const {
   if (max_bounces < 0 && !russian_roulette)
     throw InputError("--converged without Russian roulette would never end a path");
   if (threads < 0) throw InputError("--threads: must be >= 0 (0 = all)");
+  // Set by the run layer, never by users: a range outside the frame is a bug, not bad input.
+  if (first_sample >= spp || uint64_t(first_sample) + traced_spp() > spp)
+    throw std::invalid_argument(fmt::format("sample range [{}, +{}) outside the frame's {} spp", first_sample,
+                                            sample_count, spp));
 }
 
 }  // namespace pb

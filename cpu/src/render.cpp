@@ -32,14 +32,15 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   const std::unique_ptr<EmbreeScene> embree_scene = make_embree_scene(scene, settings.watertight, settings.embree_layout);
   const EmbreeScene& embree = *embree_scene;
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
-                    settings.total_samples(), settings.progress);
-  TraceJob job{embree, scene.view(), settings.path_config(), settings.spp, film, progress, isa};
+                    settings.traced_samples(), settings.progress);
+  // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share).
+  TraceJob job{embree, scene.view(), settings.path_config(), settings.traced_spp(), film, progress, isa};
 
   const auto t0 = std::chrono::steady_clock::now();
   // A pool larger than the frame's samples would only hold empty slots (--paths-in-flight 1e8 for 64
   // samples once took 10 GB).
   const uint64_t pif = std::min(settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight(threads),
-                                std::max<uint64_t>(1, settings.total_samples()));
+                                std::max<uint64_t>(1, settings.traced_samples()));
   const bool dbl = settings.precision == Precision::Double;
   TraceTotals totals;
   if (settings.strategy == Strategy::Pixel) {

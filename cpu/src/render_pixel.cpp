@@ -210,11 +210,11 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
         const uint32_t pixel = y * w + x;
         if (table) {
           const uint32_t width = uint32_t(k->lanes);
-          for (uint32_t s = 0; s < job.spp; s += width)
-            trace_samples_batched(job, *k, *table, ctx, pixel, s, int(std::min<uint32_t>(width, job.spp - s)), local);
+          for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; s += width)
+            trace_samples_batched(job, *k, *table, ctx, pixel, s, int(std::min<uint32_t>(width, end - s)), local);
           continue;
         }
-        for (uint32_t s = 0; s < job.spp; ++s) {
+        for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; ++s) {
           Vec3f L = trace_path<T, Kinds>(job, ctx, pixel, s, local);
           ++local.paths;
           if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here

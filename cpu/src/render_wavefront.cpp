@@ -47,7 +47,8 @@ namespace {
 // are neighbours on the image (coherent camera rays).
 class SampleSource {
  public:
-  SampleSource(uint64_t total, uint32_t pixels) : total_(total), pixels_(pixels) {}
+  SampleSource(uint64_t total, uint32_t pixels, uint32_t first_sample)
+      : total_(total), pixels_(pixels), first_(first_sample) {}
   // Claims up to n samples; returns the first global index and sets n to the count.
   uint64_t claim(uint64_t& n) {
     uint64_t start = next_.fetch_add(n, std::memory_order_relaxed);
@@ -55,12 +56,13 @@ class SampleSource {
     return start;
   }
   uint32_t pixel_of(uint64_t g) const { return uint32_t(g % pixels_); }
-  uint32_t sample_of(uint64_t g) const { return uint32_t(g / pixels_); }
+  uint32_t sample_of(uint64_t g) const { return first_ + uint32_t(g / pixels_); }
 
  private:
   std::atomic<uint64_t> next_{0};
   uint64_t total_;
   uint32_t pixels_;
+  uint32_t first_;  // samples [first_, first_ + total_ / pixels_) of each pixel
 };
 
 template <class T> struct PoolSlice {
@@ -330,7 +332,7 @@ template <class T, uint32_t Kinds, int W>
 TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
                       std::unique_ptr<ShadeTable> table) {
   const uint32_t pixels = job.config.width * job.config.height;
-  SampleSource source(uint64_t(pixels) * job.spp, pixels);
+  SampleSource source(uint64_t(pixels) * job.spp, pixels, job.config.first_sample);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
   // A pool that cannot fit is a setting to lower, not a std::bad_alloc (exit 2, not 1).

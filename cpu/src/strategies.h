@@ -22,7 +22,7 @@ struct TraceJob {
   const EmbreeScene& embree;
   SceneView scene;
   PathConfig config;
-  uint32_t spp;
+  uint32_t spp;  // samples traced per pixel: config.first_sample onwards
   Film& film;
   Progress& progress;
   Isa isa;  // resolved (cpu/isa.h): the batched path step's instruction set, or Scalar

@@ -106,6 +106,25 @@ bool device_available(std::string* why_not) {
   return answer.first;
 }
 
+// Neither creates a context on device 0 (the probe of device_available does): an MPI
+// rank picks its device first, so that 8 ranks do not all hold a context on GPU 0.
+int device_count() {
+  int n = 0;
+  if (cudaGetDeviceCount(&n) != cudaSuccess) {
+    (void)cudaGetLastError();
+    return 0;
+  }
+  return n;
+}
+
+int select_device(int local_rank) {
+  const int n = device_count();
+  if (n == 0) return -1;  // device_available() says why
+  const int device = (local_rank < 0 ? 0 : local_rank) % n;
+  PB_CUDA_CHECK(cudaSetDevice(device));
+  return device;
+}
+
 DeviceInfo device_info() {
   ensure_device();
   DeviceInfo info;

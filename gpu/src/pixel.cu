@@ -83,7 +83,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
     const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path<Kinds, T, kWatertight>(s, bvh, c, pixel, uint32_t(g % spp), n_bounce, n_shadow);
+      L = trace_path<Kinds, T, kWatertight>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);

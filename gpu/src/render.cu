@@ -61,7 +61,10 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
 
   const PathConfig config = settings.path_config();
   const uint32_t pixels = settings.width * settings.height;
-  const uint64_t total = settings.total_samples();
+  // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share):
+  // the kernels map g to (pixel g / spp, sample config.first_sample + g % spp).
+  const uint64_t total = settings.traced_samples();
+  const uint32_t spp = settings.traced_spp();
   const ShadowUse shadows = ShadowUse::of(scene, settings);
 
   ScopedStream stream;
@@ -105,9 +108,9 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
 
   auto run_frame = [&](uint64_t n) {
     if (settings.strategy == Strategy::Pixel)
-      return run_pixel(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance(), settings.precision,
+      return run_pixel(launch, stream.s, g, config, spp, n, fb.view, film.has_variance(), settings.precision,
                        settings.watertight, pixel_stats);
-    return pool->run(launch, stream.s, g, config, settings.spp, n, fb.view, film.has_variance());
+    return pool->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
   };
 
   // Warm-up (module load, first-touch of every buffer), then the timed frame.

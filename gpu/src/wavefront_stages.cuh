@@ -46,7 +46,7 @@ __global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig 
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const unsigned long long g = base + i;
     PathState<float> st;
-    path_begin(s, c, uint32_t(g / spp), uint32_t(g % spp), st);
+    path_begin(s, c, uint32_t(g / spp), c.first_sample + uint32_t(g % spp), st);
     store_path(cur, dst + i, st);
   }
 }

@@ -1,6 +1,10 @@
 #include "pathbench/run/ranks.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include "pathbench/run/world.h"
 
 namespace pb::run {
 
@@ -28,6 +32,18 @@ void reduce_film(Film& into, const Film& part) {
     const auto& sq_add = part.raw_sum_sq();
     for (size_t i = 0; i < sq.size(); ++i) sq[i] += sq_add[i];
   }
+}
+
+uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, double total_rate) {
+  (void)spp, (void)ranks;
+  if (remaining == 0) return 0;
+  // Not measured yet: a probe of one sample per pixel (a CPU rank's first chunk must not
+  // outlast a GPU's whole frame). Then 3/4 of what is left, shared by rate: every rank's
+  // chunk ends after about 3/4 of the frame's remaining time, whoever it is, so ranks
+  // finish close together and a fast rank needs few chunks (each GPU call costs a
+  // warm-up frame and a film copy): about log4(spp) of them.
+  const double want = rate > 0 && total_rate > 0 ? std::ceil(0.75 * double(remaining) * rate / total_rate) : 1.0;
+  return uint32_t(std::min<double>(std::max(want, 1.0), remaining));
 }
 
 }  // namespace pb::run

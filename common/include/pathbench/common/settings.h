@@ -37,6 +37,9 @@ struct PathConfig {
   uint32_t rr_start_depth;    // roulette applies from this bounce on
   uint32_t width, height;
   uint64_t seed;
+  // The first sample index this render traces (RenderSettings::first_sample): a sample's
+  // index, not its rank or chunk, keys the random stream.
+  uint32_t first_sample = 0;
 };
 
 struct RenderSettings {
@@ -57,11 +60,18 @@ struct RenderSettings {
   EmbreeLayout embree_layout = EmbreeLayout::Auto;  // CPU only
   Isa isa = Isa::Auto;                               // CPU only
   bool progress = true;
+  // The samples of every pixel this render traces: [first_sample, first_sample +
+  // traced_spp()); sample_count 0 = all spp. The run layer sets them for an MPI rank's
+  // share or chunk (run/ranks.h); the film is begun for the whole frame's spp either way,
+  // and the random stream is keyed by pixel and sample, so any split gives the same image.
+  uint32_t first_sample = 0, sample_count = 0;
 
   PathConfig path_config() const {
-    return {max_bounces, sampling, russian_roulette, rr_start_depth, width, height, seed};
+    return {max_bounces, sampling, russian_roulette, rr_start_depth, width, height, seed, first_sample};
   }
   uint64_t total_samples() const { return uint64_t(width) * height * spp; }
+  uint32_t traced_spp() const { return sample_count ? sample_count : spp - first_sample; }
+  uint64_t traced_samples() const { return uint64_t(width) * height * traced_spp(); }
   // Throws InputError (naming the offending option) on impossible settings.
   void validate() const;
 };

@@ -34,6 +34,12 @@ struct DeviceInfo {
 };
 // Throws InputError when there is no device.
 DeviceInfo device_info();
+// For an MPI rank (run/): use device `local_rank % visible devices` from now on (call it
+// before any other CUDA work of the process). Returns the device index chosen, or -1
+// where there is none (device_available says why).
+int select_device(int local_rank);
+// Visible CUDA devices (0 where none).
+int device_count();
 
 // The scene on the device: arrays and BVH, uploaded once, reusable for many renders.
 class GpuScene {

@@ -18,9 +18,14 @@
 
 namespace pb::run {
 
+// How MPI ranks share a frame's samples (ranks_render.h): Auto = Static where every rank
+// runs the same device kind, Dynamic (chunks from a shared counter) where they differ.
+enum class Balance { Auto, Static, Dynamic };
+
 struct RunOptions {
   bool profile = false;        // GPU: per-stage table on stdout and in report.extra["profile"]
   bool keep_variance = false;  // keep the variance sums even where settings.variance is off
+  Balance balance = Balance::Auto;  // MPI ranks only
 };
 
 // Renders `scene` on settings.device into `film`, which is (re)sized to the settings

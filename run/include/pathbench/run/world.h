@@ -1,0 +1,112 @@
+#pragma once
+// The ranks of this process's run (issue 13): MPI's world when pathbench was built with
+// MPI (PATHBENCH_MPI) and started by mpirun, otherwise one rank. Two implementations of
+// the same class: run/src/mpi_world.cpp (MPI) and run/src/single_world.cpp (one rank), so
+// nothing above this header knows whether MPI exists. Only the run layer's rank render
+// (ranks_render.h) and the process's entry and exit (app/main.cpp) use it.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pathbench/common/film.h"
+#include "pathbench/run/ranks.h"
+
+namespace pb::run {
+
+// A rank's failure as every rank learns it: which rank, its exit status (2: bad input, 1:
+// failed) and its message. rank < 0: none.
+struct RankFailure {
+  int rank = -1;
+  int code = 0;
+  std::string message;
+  bool failed() const { return rank >= 0; }
+};
+
+// Thrown on every rank but the one that prints (rank 0) when some rank failed: rank 0
+// has printed the message; the others only exit with the same status.
+struct PeerFailure : std::exception {
+  explicit PeerFailure(int c) : code(c) {}
+  int code;
+  const char* what() const noexcept override { return "another rank failed (rank 0 printed why)"; }
+};
+
+class World {
+ public:
+  // The process's world; the first call starts MPI when this build has it and mpirun (or
+  // another PMI launcher) started the process.
+  static World& get();
+
+  bool mpi() const { return mpi_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  int local_rank() const { return local_rank_; }  // among the ranks on this node
+  int local_size() const { return local_size_; }
+  const std::string& host() const { return host_; }
+  bool root() const { return rank_ == 0; }
+
+  // Collective: every rank gives its own failure (or none); all get the lowest failing
+  // rank's, the same on every rank.
+  RankFailure agree(const RankFailure& mine);
+  // Collective: every rank's string, in rank order, on every rank (all) or on rank 0
+  // only (gather; empty elsewhere). Within this node only: local_all.
+  std::vector<std::string> all(const std::string& mine);
+  std::vector<std::string> gather(const std::string& mine);
+  std::vector<std::string> local_all(const std::string& mine);
+  void barrier();
+  // Collective: adds every rank's film into rank 0's, exactly (64-bit integer sums,
+  // MPI_Reduce over MPI_INT64_T; the rules of reduce_film: same size, scale and variance,
+  // overflow refused with std::overflow_error on rank 0). Other ranks' films are left as
+  // they were. The variance sums (doubles) are summed in MPI's order, not bit for bit.
+  void reduce_film(Film& film);
+  // Whether rank 0 can serve a SampleDispenser from a thread (MPI gave at least
+  // MPI_THREAD_SERIALIZED); otherwise ranks split the samples statically.
+  bool can_dispense() const;
+
+  // Ends the process's part in the run: MPI_Finalize, or MPI_Abort with `code` where this
+  // rank fails alone (a failure the other ranks have not agreed on would leave them
+  // waiting). Returns `code`. Called once, by main; nothing where no World was made.
+  static int end(int code);
+
+ private:
+  World();
+  bool mpi_ = false;
+  int rank_ = 0, size_ = 1, local_rank_ = 0, local_size_ = 1;
+  std::string host_;
+  bool agreed_failure_ = false;
+  bool threads_ok_ = false;
+};
+
+// Dynamic balancing: ranks take chunks of samples ([first, first + count) of every
+// pixel) from one counter held by rank 0, which answers the other ranks from a thread of
+// its own while it renders. A chunk's size follows the asking rank's measured rate (its
+// samples per pixel per second), so a GPU and a CPU rank finish together (chunk_size).
+// Every rank constructs it and calls finish(); next() and abort() are per rank.
+class SampleDispenser {
+ public:
+  SampleDispenser(World& world, uint32_t spp);
+  ~SampleDispenser();
+  SampleDispenser(const SampleDispenser&) = delete;
+  SampleDispenser& operator=(const SampleDispenser&) = delete;
+  // The next chunk for this rank; count 0 when the frame is handed out (or aborted).
+  // `rate`: this rank's samples per pixel per second so far (0: not measured yet).
+  SampleShare next(double rate);
+  // This rank failed: hand out nothing more, so every rank reaches the next agreement
+  // within one chunk.
+  void abort();
+  // Collective (rank 0 waits for every rank's last request).
+  void finish();
+  uint64_t chunks_granted() const;  // rank 0: chunks handed out in all
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// The grant rule alone (tested in every build): `remaining` of `spp` samples per pixel
+// left, a rank of rate `rate` among ranks of total rate `total_rate` (rates of ranks
+// not measured yet counted as the mean of the measured ones by the caller).
+uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, double total_rate);
+
+}  // namespace pb::run

@@ -1,0 +1,126 @@
+// Dynamic balancing over MPI: rank 0 holds the frame's sample counter and answers the
+// other ranks' requests from a thread of its own (polling, so that it takes no core from
+// rank 0's render); rank 0 itself takes chunks under the same lock. Messages go over a
+// communicator of their own (mpi_detail::chunk_comm).
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "mpi_detail.h"
+#include "pathbench/run/world.h"
+
+namespace pb::run {
+
+namespace {
+constexpr int kAsk = 1, kGrant = 2, kQuit = 3;
+}
+
+struct SampleDispenser::Impl {
+  Impl(World& w, uint32_t s) : world(w), spp(s) {}
+  World& world;
+  uint32_t spp;
+  MPI_Comm comm = mpi_detail::chunk_comm();
+  // Rank 0's counter, guarded by `m` (its own render and the server thread take from it).
+  std::mutex m;
+  uint32_t next = 0;
+  bool aborted = false;
+  uint64_t chunks = 0;
+  std::vector<double> rates;
+  std::thread server;
+  bool done = false;  // this rank has had its last grant (or quit)
+
+  SampleShare grant(int rank, double rate) {
+    std::lock_guard<std::mutex> lock(m);
+    if (rate > 0) rates[size_t(rank)] = rate;
+    if (aborted) return {next, 0};
+    // Ranks not measured yet count as the mean of the measured ones.
+    double known = 0;
+    int measured = 0;
+    for (double r : rates)
+      if (r > 0) known += r, ++measured;
+    const double total = measured ? known * double(rates.size()) / double(measured) : 0;
+    // One rank (no mpirun): the whole frame at once, as the one-rank build does.
+    const uint32_t count = world.size() == 1 ? spp - next
+                                             : chunk_size(spp - next, spp, world.size(), rates[size_t(rank)], total);
+    const SampleShare s{next, count};
+    next += count;
+    if (count) ++chunks;
+    return s;
+  }
+
+  void serve() {
+    int finished = 0;  // ranks that have had their last grant or quit
+    while (finished < world.size() - 1) {
+      int flag = 0;
+      MPI_Status st;
+      MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, comm, &flag, &st);
+      if (!flag) {
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+        continue;
+      }
+      if (st.MPI_TAG == kAsk) {
+        double rate = 0;
+        MPI_Recv(&rate, 1, MPI_DOUBLE, st.MPI_SOURCE, kAsk, comm, MPI_STATUS_IGNORE);
+        const SampleShare s = grant(st.MPI_SOURCE, rate);
+        const uint32_t g[2] = {s.first, s.count};
+        MPI_Send(g, 2, MPI_UINT32_T, st.MPI_SOURCE, kGrant, comm);
+        if (s.count == 0) ++finished;
+      } else {
+        MPI_Recv(nullptr, 0, MPI_BYTE, st.MPI_SOURCE, kQuit, comm, MPI_STATUS_IGNORE);
+        std::lock_guard<std::mutex> lock(m);
+        aborted = true;
+        ++finished;
+      }
+    }
+  }
+};
+
+SampleDispenser::SampleDispenser(World& world, uint32_t spp) : impl_(std::make_unique<Impl>(world, spp)) {
+  impl_->rates.assign(size_t(world.size()), 0.0);
+  if (world.root() && world.size() > 1) impl_->server = std::thread([this] { impl_->serve(); });
+}
+
+SampleDispenser::~SampleDispenser() {
+  if (impl_->server.joinable()) impl_->server.join();
+}
+
+SampleShare SampleDispenser::next(double rate) {
+  Impl& d = *impl_;
+  if (d.done) return {0, 0};
+  SampleShare s;
+  if (d.world.root()) {
+    s = d.grant(0, rate);
+  } else {
+    uint32_t g[2] = {0, 0};
+    MPI_Send(&rate, 1, MPI_DOUBLE, 0, kAsk, d.comm);
+    MPI_Recv(g, 2, MPI_UINT32_T, 0, kGrant, d.comm, MPI_STATUS_IGNORE);
+    s = {g[0], g[1]};
+  }
+  if (s.count == 0) d.done = true;
+  return s;
+}
+
+void SampleDispenser::abort() {
+  Impl& d = *impl_;
+  if (d.done) return;
+  d.done = true;
+  if (d.world.root()) {
+    std::lock_guard<std::mutex> lock(d.m);
+    d.aborted = true;
+  } else {
+    MPI_Send(nullptr, 0, MPI_BYTE, 0, kQuit, d.comm);
+  }
+}
+
+void SampleDispenser::finish() {
+  if (impl_->server.joinable()) impl_->server.join();
+}
+
+uint64_t SampleDispenser::chunks_granted() const {
+  std::lock_guard<std::mutex> lock(impl_->m);
+  return impl_->chunks;
+}
+
+}  // namespace pb::run

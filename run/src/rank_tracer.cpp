@@ -1,0 +1,81 @@
+#include "rank_tracer.h"
+
+#include <algorithm>
+
+#include <fmt/core.h>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/cpu/render.h"
+#if PATHBENCH_HAVE_CUDA
+#include "pathbench/gpu/render.h"
+#endif
+
+namespace pb::run {
+
+struct RankTracer::Gpu {
+#if PATHBENCH_HAVE_CUDA
+  explicit Gpu(const Scene& s) : scene(s) {}
+  gpu::GpuScene scene;
+#endif
+};
+
+RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options)
+    : scene_(scene), settings_(settings), options_(options) {
+  settings_.validate();
+  if (settings_.device == Device::Gpu) {
+    std::string why;
+    if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+#if PATHBENCH_HAVE_CUDA
+    gpu_ = std::make_unique<Gpu>(scene);  // BVH built and uploaded once for every chunk
+#endif
+  }
+}
+
+RankTracer::~RankTracer() = default;
+
+void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
+  RenderSettings s = settings_;
+  s.first_sample = share.first;
+  s.sample_count = share.count;
+  s.progress = false;  // ranks' bars would interleave on one terminal
+  RunReport chunk;
+  if (s.device == Device::Cpu) {
+    cpu::render(scene_, s, film, chunk);  // Film::add accumulates into the rank's film
+  } else {
+#if PATHBENCH_HAVE_CUDA
+    // The device's film comes back whole, replacing the host's: the first chunk lands in
+    // the rank's film (begun, so zero), later ones in a scratch film added to it. A static
+    // split (one chunk) thus costs no extra copy or addition.
+    if (chunks_ == 0) {
+      gpu::render(scene_, gpu_->scene, s, film, chunk, options_.profile);
+    } else {
+      // Begun once, for the frame's scale: every download replaces all its sums and counts.
+      if (scratch_.width() != film.width() || scratch_.height() != film.height() ||
+          scratch_.has_variance() != film.has_variance()) {
+        scratch_ = Film(film.width(), film.height(), film.has_variance());
+        scratch_.begin(s.spp, scene_.max_emission());
+      }
+      gpu::render(scene_, gpu_->scene, s, scratch_, chunk, options_.profile);
+      reduce_film(film, scratch_);
+    }
+#endif
+  }
+  // The first chunk's description (device, memory, layout) stands for the rank's;
+  // counts and times add up over chunks.
+  if (chunks_++ == 0) {
+    const RayCounts none;
+    report = chunk;
+    report.rays = none;
+    report.paths = report.discarded_samples = 0;
+    report.seconds = report.device_seconds = 0;
+  }
+  report.rays += chunk.rays;
+  report.paths += chunk.paths;
+  report.discarded_samples += chunk.discarded_samples;
+  report.seconds += chunk.seconds;
+  report.device_seconds += chunk.device_seconds;
+  report.peak_device_bytes = std::max(report.peak_device_bytes, chunk.peak_device_bytes);
+  report.tracer_host_bytes = std::max(report.tracer_host_bytes, chunk.tracer_host_bytes + scratch_.bytes());
+}
+
+}  // namespace pb::run

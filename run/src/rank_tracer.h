@@ -1,0 +1,36 @@
+#pragma once
+// One rank's tracer for the rank render (ranks_render.cpp): settings checked and the
+// device's scene built once, then any number of sample chunks traced into one film.
+#include <memory>
+
+#include "pathbench/common/film.h"
+#include "pathbench/common/report.h"
+#include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
+#include "pathbench/run/ranks.h"
+#include "pathbench/run/run.h"
+
+namespace pb::run {
+
+class RankTracer {
+ public:
+  // Validates `settings`, checks the device, and on the GPU uploads the scene once.
+  // Throws InputError like run::render.
+  RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options);
+  ~RankTracer();
+  // Traces samples `share` of every pixel into `film` (begun for the whole frame, and
+  // holding nothing but this tracer's earlier chunks), and adds the chunk's rays, paths,
+  // discarded samples and times into `report`.
+  void trace(SampleShare share, Film& film, RunReport& report);
+
+ private:
+  const Scene& scene_;
+  RenderSettings settings_;
+  RunOptions options_;
+  Film scratch_;  // GPU: the device's film comes back whole, so later chunks land here first
+  struct Gpu;
+  std::unique_ptr<Gpu> gpu_;
+  int chunks_ = 0;
+};
+
+}  // namespace pb::run

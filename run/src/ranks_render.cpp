@@ -1,0 +1,209 @@
+#include "pathbench/run/ranks_render.h"
+
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <optional>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+#include "pathbench/common/errors.h"
+#include "pathbench/run/ranks_report.h"
+#include "pathbench/run/run_context.h"
+#include "pathbench/run/world.h"
+#include "rank_tracer.h"
+#if PATHBENCH_HAVE_CUDA
+#include "pathbench/gpu/render.h"
+#endif
+
+namespace pb::run {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+RankFailure failure_of(std::exception_ptr e, int rank) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const InputError& x) {
+    return {rank, kExitBadInput, x.what()};
+  } catch (const std::exception& x) {
+    return {rank, kExitFailed, x.what()};
+  }
+}
+
+// After an agreement: the failure, thrown as on_every_rank documents.
+void throw_agreed(const World& w, const RankFailure& f) {
+  if (!f.failed()) return;
+  if (!w.root()) throw PeerFailure(f.code);
+  const std::string message = fmt::format("rank {} of {}: {}", f.rank, w.size(), f.message);
+  if (f.code == kExitBadInput) throw InputError(message);
+  throw std::runtime_error(message);
+}
+
+// A CPU rank's threads: the cores the launcher bound it to, or where it bound none
+// (mpirun --bind-to none), this node's cores less one per GPU rank, shared by its CPU ranks.
+int cpu_share(const std::vector<std::string>& local_devices) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  const int bound = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : hardware_threads();
+  if (bound < hardware_threads()) return std::max(1, bound);
+  const int gpus = int(std::count(local_devices.begin(), local_devices.end(), "gpu"));
+  const int cpus = std::max<int>(1, int(local_devices.size()) - gpus);
+  return std::max(1, (hardware_threads() - gpus) / cpus);
+}
+
+int gpu_count() {
+#if PATHBENCH_HAVE_CUDA
+  return gpu::device_count();  // no context yet: the rank has not picked its GPU
+#else
+  return 0;
+#endif
+}
+}  // namespace
+
+void on_every_rank(const std::function<void()>& step) {
+  World& w = World::get();
+  if (!w.mpi()) return step();
+  RankFailure mine;
+  try {
+    step();
+  } catch (const PeerFailure&) {
+    throw;
+  } catch (...) {
+    mine = failure_of(std::current_exception(), w.rank());
+  }
+  throw_agreed(w, w.agree(mine));
+}
+
+std::string rank_device(const std::string& asked) {
+  if (asked != "hybrid") return asked;
+  World& w = World::get();
+  if (w.size() < 2)
+    throw InputError("--device hybrid: needs two or more MPI ranks (mpirun -np 2 pathbench render --device hybrid "
+                     "...): one process renders on one device");
+  // One GPU rank per visible GPU, at least one, and at least one CPU rank per node.
+  const int gpu_ranks = std::max(1, std::min(gpu_count(), w.local_size() - 1));
+  return w.local_rank() < gpu_ranks ? "gpu" : "cpu";
+}
+
+std::string settings_key(const Scene& scene, const RenderSettings& s) {
+  // FNV-1a over the scene's arrays: two nodes' copies of a scene file must agree.
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* p, size_t n) {
+    for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ull;
+  };
+  mix(scene.positions.data(), scene.positions.size() * sizeof(scene.positions[0]));
+  mix(scene.triangles.data(), scene.triangles.size() * sizeof(scene.triangles[0]));
+  mix(scene.material_ids.data(), scene.material_ids.size() * sizeof(uint32_t));
+  mix(scene.materials.data(), scene.materials.size() * sizeof(scene.materials[0]));
+  return fmt::format(
+      "scene={} scene_hash={:016x} width={} height={} spp={} bounces={} sampling={} strategy={} seed={} rr={} "
+      "rr_start={} paths_in_flight={} variance={} watertight={} precision={} embree_layout={} isa={}",
+      scene.name, h, s.width, s.height, s.spp, s.max_bounces, to_string(s.sampling), to_string(s.strategy), s.seed,
+      s.russian_roulette, s.rr_start_depth, s.paths_in_flight, s.variance, s.watertight, to_string(s.precision),
+      to_string(s.embree_layout), to_string(s.isa));
+}
+
+bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report,
+                  const RunOptions& options, const std::string& run_key) {
+  World& w = World::get();
+  if (!w.mpi() || w.size() == 1) {
+    render(scene, settings, film, report, options);
+    return true;
+  }
+  // 1. One frame: every rank asks for the same one (MPMD lines may differ in device and threads only).
+  const std::string key = settings_key(scene, settings) + (run_key.empty() ? "" : " " + run_key);
+  const std::vector<std::string> keys = w.all(key);
+  on_every_rank([&] {
+    if (keys[size_t(w.rank())] != keys[0])
+      throw InputError(fmt::format("its settings differ from rank 0's: {} (MPMD lines may differ only in --device "
+                                   "and --threads)", first_difference(keys[0], keys[size_t(w.rank())])));
+  });
+  // 2. Each rank's device: GPU ranks take local rank % visible GPUs, CPU ranks their cores.
+  const std::vector<std::string> local_devices = w.local_all(to_string(settings.device));
+  const std::vector<std::string> devices = w.all(to_string(settings.device));
+  RenderSettings s = settings;
+  std::unique_ptr<RankTracer> tracer;
+  int gpu_index = -1;
+  on_every_rank([&] {
+#if PATHBENCH_HAVE_CUDA
+    // Before any other CUDA call (RankTracer's device check), so the rank's context is on its GPU.
+    if (s.device == Device::Gpu) gpu_index = gpu::select_device(w.local_rank());
+#endif
+    if (s.device == Device::Cpu && s.threads == 0) s.threads = cpu_share(local_devices);
+    tracer = std::make_unique<RankTracer>(scene, s, options);
+    const bool variance = s.variance || options.keep_variance || film.has_variance();
+    if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
+      film = Film(s.width, s.height, variance);
+    film.begin(s.spp, scene.max_emission());  // the frame's scale on every rank
+  });
+  Balance balance = options.balance;
+  if (balance == Balance::Auto)
+    balance = std::all_of(devices.begin(), devices.end(), [&](const auto& d) { return d == devices[0]; })
+                  ? Balance::Static : Balance::Dynamic;
+  if (!w.can_dispense()) balance = Balance::Static;
+
+  // 3. The frame: from a common start to the reduced film on rank 0.
+  w.barrier();
+  const Clock::time_point t0 = Clock::now();
+  const nlohmann::json load0 = load_sample();
+  RunReport mine;
+  RankFailure failed;
+  uint32_t samples = 0;
+  int chunks = 0;
+  uint64_t granted = 0;  // rank 0, dynamic: chunks handed out in all
+  {
+    std::optional<SampleDispenser> dispenser;  // dynamic balancing only: rank 0 then serves it
+    if (balance == Balance::Dynamic) dispenser.emplace(w, s.spp);
+    try {
+      if (balance == Balance::Static) {
+        const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
+        if (share.count) tracer->trace(share, film, mine), samples += share.count, ++chunks;
+      } else {
+        for (;;) {
+          const double rate = mine.seconds > 0 ? double(samples) / mine.seconds : 0.0;
+          const SampleShare share = dispenser->next(rate);
+          if (share.count == 0) break;
+          tracer->trace(share, film, mine);
+          samples += share.count;
+          ++chunks;
+        }
+      }
+    } catch (...) {
+      failed = failure_of(std::current_exception(), w.rank());
+      if (dispenser) dispenser->abort();
+    }
+    if (dispenser) dispenser->finish();
+    throw_agreed(w, w.agree(failed));
+    if (dispenser && w.root()) granted = dispenser->chunks_granted();
+  }
+  const double busy_wall = since(t0);
+  const Clock::time_point r0 = Clock::now();
+  on_every_rank([&] { w.reduce_film(film); });
+  const double reduce_seconds = since(r0), frame_seconds = since(t0);
+
+  // 4. One report, on rank 0.
+  mine.peak_host_bytes = peak_resident_bytes();
+  const std::vector<std::string> ranks = w.gather(
+      rank_entry(w.rank(), w.host(), s, mine, gpu_index, samples, chunks, busy_wall).dump());
+  on_every_rank([&] {
+    if (!w.root()) return;
+    report = mine;
+    report.scene = scene.name;
+    report.triangles = scene.triangles.size();
+    report.settings = settings;
+    report.settings.threads = s.threads;
+    report.load = load_between(load0, load_sample());
+    report.fingerprint = run_fingerprint(s.device == Device::Gpu);
+    merge_ranks(report, ranks, frame_seconds, reduce_seconds, balance == Balance::Dynamic ? "dynamic" : "static");
+    if (balance == Balance::Dynamic) report.extra["ranks"]["chunks_granted"] = granted;
+    check_discarded(scene, settings, report);
+  });
+  return w.root();
+}
+
+}  // namespace pb::run

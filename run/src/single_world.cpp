@@ -1,0 +1,44 @@
+// The one-rank world of a build without MPI (PATHBENCH_MPI=OFF or MPI not found): every
+// collective is the identity, the dispenser hands the whole frame to its one rank.
+#include <unistd.h>
+
+#include <climits>
+
+#include "pathbench/run/world.h"
+
+namespace pb::run {
+
+World::World() {
+  char name[HOST_NAME_MAX + 1] = {};
+  if (::gethostname(name, sizeof name - 1) == 0) host_ = name;
+}
+
+World& World::get() {
+  static World w;
+  return w;
+}
+
+RankFailure World::agree(const RankFailure& mine) { return mine; }
+std::vector<std::string> World::all(const std::string& mine) { return {mine}; }
+std::vector<std::string> World::gather(const std::string& mine) { return {mine}; }
+std::vector<std::string> World::local_all(const std::string& mine) { return {mine}; }
+void World::barrier() {}
+void World::reduce_film(Film&) {}
+bool World::can_dispense() const { return true; }
+int World::end(int code) { return code; }  // no MPI: nothing to end
+
+struct SampleDispenser::Impl {
+  uint32_t spp, next = 0;
+};
+SampleDispenser::SampleDispenser(World&, uint32_t spp) : impl_(std::make_unique<Impl>(Impl{spp})) {}
+SampleDispenser::~SampleDispenser() = default;
+SampleShare SampleDispenser::next(double) {
+  const SampleShare s{impl_->next, impl_->spp - impl_->next};
+  impl_->next = impl_->spp;
+  return s;
+}
+void SampleDispenser::abort() { impl_->next = impl_->spp; }
+void SampleDispenser::finish() {}
+uint64_t SampleDispenser::chunks_granted() const { return impl_->next > 0 ? 1 : 0; }
+
+}  // namespace pb::run

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# MPI ranks on a GPU host (issue 13), for the device machine: build with MPI, run the
+# mpi tests, check that 2 GPU ranks (on one GPU when only one is visible) and the
+# CPU+GPU hybrid give the one-GPU image byte for byte, and run tools/mpi_scaling.py.
+# Everything lands under $OUT (default ./device-out). Phases: build check scaling.
+#   source .gpu-deps/unpack.sh is done here (pack-deps.sh --mpi); ../shared/gpu-host/README.md.
+set -uo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+OUT=${OUT:-$PWD/device-out}
+mkdir -p "$OUT"
+phases=${*:-build check scaling}
+has() { [[ " $phases " == *" $1 "* ]]; }
+log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
+if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 NCCL_NVLS_ENABLE=0
+MPIRUN=$(command -v mpirun.openmpi || command -v mpirun)
+B=build-mpi
+PB=$B/bin/pathbench
+gpus=$(nvidia-smi -L | wc -l)
+log "GPUs: $gpus, mpirun: $MPIRUN"
+
+if has build; then
+  cmake -S . -B $B -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF -DPATHBENCH_PYTHON=OFF \
+        -DPATHBENCH_MPI=ON -DMPI_CXX_COMPILER=$(command -v mpicxx.openmpi || command -v mpicxx) \
+        -DCMAKE_CUDA_ARCHITECTURES=90 > "$OUT/configure.txt" 2>&1 || { tail -30 "$OUT/configure.txt"; exit 1; }
+  cmake --build $B -j 16 --target pathbench pathbench_unit_tests > "$OUT/build.txt" 2>&1 \
+    || { grep -E "error|FAILED" -A3 "$OUT/build.txt" | head -60; exit 1; }
+  log "build ok"
+  (cd $B && ctest -L mpi --output-on-failure -j4 > "$OUT/ctest-mpi.txt" 2>&1; tail -4 "$OUT/ctest-mpi.txt")
+  (cd $B && ctest -R 'RankSplit|RunRanks' --output-on-failure > "$OUT/ctest-ranks.txt" 2>&1; tail -3 "$OUT/ctest-ranks.txt")
+fi
+
+mpi() { "$MPIRUN" --oversubscribe --bind-to none "$@"; }
+same() { if cmp -s "$1" "$2"; then log "IDENTICAL $3"; else log "DIFFERENT $3"; fi; }
+secs() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); r=d.get('ranks'); print(r['frame_seconds'] if r else d.get('device_seconds', d['seconds']), (r or {}).get('device_share',''), (r or {}).get('parallel_efficiency',''), (r or {}).get('reduce_seconds',''))" "$1"; }
+if has check; then
+  for frame in "256 256 800" "2048 2048 1024"; do
+    set -- $frame
+    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2"
+    tag=$1x$2x$3
+    $PB $f --device gpu --out "$OUT/gpu1-$tag.pfm" --report "$OUT/gpu1-$tag.json"
+    if [ "$1" = 256 ]; then  # the CPU alone on the big frame would take minutes
+      $PB $f --device cpu --out "$OUT/cpu1-$tag.pfm" --report "$OUT/cpu1-$tag.json"
+      same "$OUT/gpu1-$tag.pfm" "$OUT/cpu1-$tag.pfm" "$tag: one CPU process vs one GPU process"
+    fi
+    mpi -np 2 $PB $f --device gpu --out "$OUT/gpu2-$tag.pfm" --report "$OUT/gpu2-$tag.json"
+    same "$OUT/gpu1-$tag.pfm" "$OUT/gpu2-$tag.pfm" "$tag: 2 GPU ranks (on $gpus GPUs) vs one GPU"
+    mpi -np 1 $PB $f --device gpu --out "$OUT/hy-$tag.pfm" --report "$OUT/hy-$tag.json" : \
+        -np 1 $PB $f --device cpu --out "$OUT/hy-$tag.pfm" --report "$OUT/hy-$tag.json"
+    same "$OUT/gpu1-$tag.pfm" "$OUT/hy-$tag.pfm" "$tag: hybrid GPU+CPU (MPMD, dynamic) vs one GPU"
+    log "$tag seconds [frame share efficiency reduce]: gpu1 $(secs "$OUT/gpu1-$tag.json") | gpu2 $(secs "$OUT/gpu2-$tag.json") | hybrid $(secs "$OUT/hy-$tag.json")"
+  done
+  rm -f "$OUT"/*.pfm
+fi
+if has scaling; then
+  python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" --cpu-ranks 1,2,4 --reps 3 \
+      --out-dir "$OUT/scaling" > "$OUT/scaling.txt" 2>&1
+  log "scaling: $(tail -3 "$OUT/scaling.txt" | tr '\n' ' ')"
+fi

@@ -1,0 +1,95 @@
+#!/bin/sh
+# `pathbench render` over MPI ranks (issue 13), one case per CTest test:
+#   sh ranks.sh CASE PATHBENCH MPIEXEC DIR
+# np2, np3        mpirun -np N gives the one-process image byte for byte (static and dynamic)
+# mpmd_threads    two MPMD lines differing only in --threads, dynamic chunks: same bytes
+# mpmd_mismatch   MPMD lines differing in --spp: refused, exit 2, no image
+# failing_rank    rank 1 cannot read its scene: every rank ends, exit 2, rank 1's message
+# hybrid_no_gpu   --device hybrid where no GPU can run: exit 2, the GPU rank's message
+# killed_rank     rank 1 SIGKILLed mid-render: the run ends within 30 s, non-zero, no image
+# accuracy        `accuracy --quick`: the ranks' reference equals the one-process reference
+# gpu2, hybrid    (CUDA builds; skipped, status 77, without a usable GPU) 2 GPU ranks, and
+#                 --device hybrid (GPU + CPU ranks, dynamic), give the one-GPU image
+# Small frames (64x64): each case takes a few seconds on 2 cores.
+set -u
+case_name=$1
+pb=$2
+mpiexec=$3
+dir=$4
+rm -rf "$dir"
+mkdir -p "$dir"
+cd "$dir" || exit 1
+# CI runs as root on 2 cores.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+mpi="$mpiexec --oversubscribe --bind-to none"
+base="render --quiet --width 64 --height 64 --bounces 2"
+frame="$base --spp 24"
+fail() { echo "ranks.sh $case_name: $*" >&2; exit 1; }
+one() { "$pb" $frame --threads 1 --out one.pfm || fail "one-process render failed"; }
+same() { cmp -s one.pfm "$1" || fail "$1 differs from the one-process image"; }
+# Runs mpirun, keeps its stderr in err.txt and its status in $status, bounded by 60 s.
+run() {
+  timeout 60 $mpi "$@" >out.txt 2>err.txt
+  status=$?
+}
+refused() {  # STATUS-WANTED REGEX FILE
+  [ "$status" = "$1" ] || { cat err.txt >&2; fail "exit status $status, wanted $1"; }
+  grep -Eq "$2" err.txt || { cat err.txt >&2; fail "no message matching '$2'"; }
+  [ ! -e "$3" ] || fail "$3 was written"
+  ls | grep -q '\.tmp' && fail "a temporary file was left: $(ls)"
+  return 0
+}
+
+case $case_name in
+  np2|np3)
+    n=${case_name#np}
+    one
+    for balance in static dynamic; do
+      run -np "$n" "$pb" $frame --balance $balance --out $balance.pfm --report $balance.json
+      [ "$status" = 0 ] || { cat err.txt >&2; fail "mpirun -np $n --balance $balance: status $status"; }
+      same $balance.pfm
+      grep -q "\"count\": $n" $balance.json || fail "the report has no ranks section of $n ranks"
+      grep -q '"parallel_efficiency"' $balance.json || fail "the report has no parallel efficiency"
+    done ;;
+  mpmd_threads)
+    one
+    run -np 1 "$pb" $frame --balance dynamic --threads 2 --out mpmd.pfm : -np 1 "$pb" $frame --balance dynamic --threads 1 --out mpmd.pfm
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    same mpmd.pfm ;;
+  mpmd_mismatch)
+    run -np 1 "$pb" $frame --out x.pfm : -np 1 "$pb" $frame --out x.pfm --seed 7
+    refused 2 "rank 1 of 2: its settings differ from rank 0's: seed=7 here, seed=0 on rank 0" x.pfm ;;
+  failing_rank)
+    run -np 1 "$pb" $frame --out x.pfm : -np 1 "$pb" $frame --out x.pfm --scene no-such-scene.json
+    refused 2 "rank 1 of 2: .*no-such-scene.json" x.pfm ;;
+  hybrid_no_gpu)
+    run -np 2 "$pb" $frame --device hybrid --out x.pfm
+    refused 2 "rank 0 of 2: --device gpu: " x.pfm ;;
+  killed_rank)
+    start=$(date +%s)
+    # Rank 1 is a shell that starts pathbench (which joins the run as rank 1) and kills it.
+    run -np 1 "$pb" $base --spp 100000 --out x.pfm : \
+        -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
+    elapsed=$(( $(date +%s) - start ))
+    [ "$status" != 0 ] || fail "the run succeeded"
+    [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
+    [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
+    grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
+    refused "$status" "." x.pfm ;;
+  accuracy)
+    "$pb" accuracy --quick --no-report-tool --out-dir one >one.log 2>&1 || { cat one.log >&2; fail "one process failed"; }
+    run -np 2 "$pb" accuracy --quick --no-report-tool --out-dir two
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    for f in one/reference-*.pfm; do
+      cmp -s "$f" "two/${f#one/}" || fail "two/${f#one/} differs from the one-process reference"
+    done
+    grep -q '"parallel_efficiency"' two/reference-*.json || fail "the reference's report has no ranks section" ;;
+  gpu2|hybrid)
+    "$pb" $frame --device gpu --out gpu.pfm 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
+    if [ $case_name = gpu2 ]; then run -np 2 "$pb" $frame --device gpu --out x.pfm
+    else run -np 2 "$pb" $frame --device hybrid --out x.pfm --report x.json; fi
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    cmp -s gpu.pfm x.pfm || fail "x.pfm differs from the one-GPU image" ;;
+  *) fail "unknown case" ;;
+esac
+echo "ranks.sh $case_name: ok"
