@@ -15,12 +15,18 @@
 #include "pathbench/common/output_file.h"
 #include "render_command.h"
 #include "reproduce_command.h"
+#include "version.h"
 
 int main(int argc, char** argv) {
   // `history` takes its own arguments (Python's argparse), so it is handed over before CLI11 parses.
   if (argc >= 2 && std::string_view(argv[1]) == "history") return pb::app::run_history(argc - 2, argv + 2);
   CLI::App app{"pathbench: CPU/GPU path-tracing benchmark suite"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", [] {
+    std::string text = pb::app::version_text();
+    text.pop_back();  // CLI11 adds the last newline
+    return text;
+  }, "print the version, git revision and build flags");
   pb::app::RenderOptions render;
   auto* render_cmd = app.add_subcommand("render", "render one image and write its run report");
   pb::app::add_render_options(*render_cmd, render);
