@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the format test scenes beside this file (committed; rerun after a change):
-one scene as JSON (instanced.json), glTF (instanced.gltf), Mitsuba 3 XML
+one scene as JSON (instanced.json, and flattened.json without instancing), glTF (instanced.gltf), Mitsuba 3 XML
 (instanced.xml), and cube.obj as ASCII and binary PLY. test_scene_formats.cpp checks
 that each loads to the same triangles as its JSON or OBJ twin."""
 import base64, json, math, struct
@@ -54,6 +54,10 @@ scene = {
                   {"material": "light", "vertices": LIGHT, "indices": [[0, 1, 2], [0, 2, 3]]}],
 }
 (HERE / "instanced.json").write_text(json.dumps(scene, indent=1) + "\n")
+# The same scene without instancing: the mesh listed once per placement.
+flat = dict(scene, description="instanced.json flattened by hand (make_format_scenes.py).")
+flat["meshes"] = [{"file": "cube.obj", "material": "blue", "transform": t} for t in scene["meshes"][0]["instances"]]
+(HERE / "flattened.json").write_text(json.dumps(flat, indent=1) + "\n")
 
 # glTF: one buffer (cube, floor, light positions and indices), embedded as base64.
 tris = TRIS
