@@ -74,9 +74,11 @@ TEST(ScenePly, AsciiAndBinaryAreTheObj) {
 TEST(SceneGltf, IsTheJsonTwin) {
   testing::internal::CaptureStderr();
   const Scene gltf = load_scene(kFormats + "instanced.gltf");
+  const Scene glb = load_scene(kFormats + "instanced.glb");
   testing::internal::GetCapturedStderr();
   const Scene json = load_scene(kFormats + "instanced.json");
   expect_same_scene(json, gltf, 1e-5f);
+  expect_same_scene(gltf, glb, 0);
   // The cube mesh is one prototype placed by two nodes.
   ASSERT_EQ(gltf.instances.size(), 4u);  // every mesh node is an instance
   EXPECT_EQ(gltf.instances[0].prototype, gltf.instances[1].prototype);

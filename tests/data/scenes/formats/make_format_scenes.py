@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the format test scenes beside this file (committed; rerun after a change):
-one scene as JSON (instanced.json, and flattened.json without instancing), glTF (instanced.gltf), Mitsuba 3 XML
+one scene as JSON (instanced.json, and flattened.json without instancing), glTF (instanced.gltf, .glb), Mitsuba 3 XML
 (instanced.xml), and cube.obj as ASCII and binary PLY. test_scene_formats.cpp checks
 that each loads to the same triangles as its JSON or OBJ twin."""
 import base64, json, math, struct
@@ -103,6 +103,13 @@ gltf = {
 }
 gltf["buffers"] = [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]
 (HERE / "instanced.gltf").write_text(json.dumps(gltf, indent=1) + "\n")
+# The same as a .glb: the JSON chunk, then the buffer as the BIN chunk.
+glb_json = dict(gltf, buffers=[{"byteLength": len(blob)}])
+chunk = json.dumps(glb_json).encode()
+chunk += b" " * (-len(chunk) % 4)
+bin_chunk = blob + b"\0" * (-len(blob) % 4)
+body = struct.pack("<II", len(chunk), 0x4E4F534A) + chunk + struct.pack("<II", len(bin_chunk), 0x004E4942) + bin_chunk
+(HERE / "instanced.glb").write_bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
 
 m = " ".join(str(MATRIX[r][c]) for r in range(3) for c in range(4)) + " 0 0 0 1"
 (HERE / "instanced.xml").write_text(f"""<!-- Twin of instanced.json (make_format_scenes.py): Mitsuba 3 renders it as it is. -->
