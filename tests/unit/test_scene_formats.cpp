@@ -4,8 +4,11 @@
 // transforms (rotate, matrix) and instancing; losses are named, or fatal when strict.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
@@ -182,6 +185,82 @@ TEST_F(TempDir, MalformedFilesNameTheFileAndFormat) {
             std::string::npos);
   EXPECT_NE(error_of([&] { load_scene(write("tri.stl", "solid x\n")); }).find("tri.stl: STL files are not read by pathbench"),
             std::string::npos);
+}
+
+// A Mitsuba scene around one shape with the given BSDF, for the mapping tests.
+std::string mitsuba_with(const std::string& bsdf, const std::string& sensor_extra = "") {
+  return R"(<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="60"/>)" + sensor_extra +
+         R"(<transform name="to_world"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/><rfilter type="box"/></film>
+    </sensor><shape type="cube">)" + bsdf + R"(</shape>
+    <shape type="rectangle"><transform name="to_world"><translate z="3"/></transform>
+    <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape></scene>)";
+}
+
+TEST_F(TempDir, MitsubaBsdfsMapToPathbenchMaterials) {
+  auto cube_material = [&](const std::string& bsdf) {
+    testing::internal::CaptureStderr();
+    const Scene s = load_scene(write("m.xml", mitsuba_with(bsdf)));
+    testing::internal::GetCapturedStderr();
+    return s.materials[s.material_ids[0]];
+  };
+  Material m = cube_material(R"(<bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.3, 0.4"/></bsdf></bsdf>)");
+  EXPECT_EQ(m.kind, MaterialKind::Diffuse);
+  EXPECT_FLOAT_EQ(m.albedo.z, 0.4f);
+  m = cube_material(R"(<bsdf type="conductor"><string name="material" value="none"/><rgb name="specular_reflectance" value="0.9"/></bsdf>)");
+  EXPECT_EQ(m.kind, MaterialKind::Mirror);
+  EXPECT_FLOAT_EQ(m.albedo.x, 0.9f);
+  m = cube_material(R"(<bsdf type="roughconductor"><string name="distribution" value="ggx"/><float name="alpha" value="0.3"/></bsdf>)");
+  EXPECT_EQ(m.kind, MaterialKind::RoughConductor);
+  EXPECT_FLOAT_EQ(m.alpha, 0.3f);
+  m = cube_material(R"(<bsdf type="dielectric"><string name="int_ior" value="water"/><float name="ext_ior" value="1"/></bsdf>)");
+  EXPECT_EQ(m.kind, MaterialKind::Dielectric);
+  EXPECT_FLOAT_EQ(m.ior, 1.333f);
+  m = cube_material(R"(<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.25"/></bsdf>)");
+  EXPECT_EQ(m.kind, MaterialKind::Diffuse);  // a stand-in, named as lost
+  EXPECT_FLOAT_EQ(m.albedo.y, 0.25f);
+  // Named as lost, or an error with strict.
+  EXPECT_NE(error_of([&] { load_scene(write("p.xml", mitsuba_with(R"(<bsdf type="plastic"/>)")), {.strict = true}); })
+                .find("p.xml: bsdf 'plastic' (a diffuse stand-in is used): not modelled by pathbench (--strict)"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { load_scene(write("b.xml", mitsuba_with(R"(<bsdf type="roughconductor"/>)")), {.strict = true}); })
+                .find("microfacet distribution 'beckmann' (rendered as GGX)"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { load_scene(write("i.xml", mitsuba_with(R"(<bsdf type="dielectric"><string name="int_ior" value="unobtainium"/></bsdf>)"))); })
+                .find("i.xml: Mitsuba XML: <bsdf type=\"dielectric\">: int_ior: unknown index of refraction 'unobtainium'"),
+            std::string::npos);
+}
+
+TEST_F(TempDir, MitsubaFieldOfViewFollowsItsAxis) {
+  // fov 60 along x on a 200x100 film: tan(fov_y / 2) = tan(30 deg) / 2.
+  const Scene x = load_scene(write("x.xml", mitsuba_with("")));
+  EXPECT_NEAR(x.camera.tan_half_fov_y, std::tan(kPi<double> / 6) / 2, 1e-6);
+  const Scene y = load_scene(write("y.xml", mitsuba_with("", R"(<string name="fov_axis" value="y"/>)")));
+  EXPECT_NEAR(y.camera.tan_half_fov_y, std::tan(kPi<double> / 6), 1e-6);
+  EXPECT_NEAR(y.camera.forward.z, -1, 1e-6);  // looking from z = 5 to the origin
+}
+
+TEST_F(TempDir, GltfMetalsAreRoughConductors) {
+  // instanced.gltf with its blue material made metallic (roughness 0.5: alpha 0.25).
+  std::ifstream in(kFormats + "instanced.gltf");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = R"("baseColorFactor": [
+     0.1,
+     0.2,
+     0.6,
+     1
+    ],
+    "metallicFactor": 0)";
+  const size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), R"("baseColorFactor": [0.1, 0.2, 0.6, 1], "metallicFactor": 1, "roughnessFactor": 0.5)");
+  testing::internal::CaptureStderr();
+  const Scene s = load_scene(write("metal.gltf", text));
+  testing::internal::GetCapturedStderr();
+  const Material& m = s.materials[s.material_ids[0]];
+  EXPECT_EQ(m.kind, MaterialKind::RoughConductor);
+  EXPECT_FLOAT_EQ(m.alpha, 0.25f);
+  EXPECT_FLOAT_EQ(m.albedo.z, 0.6f);
 }
 
 }  // namespace
