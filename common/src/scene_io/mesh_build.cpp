@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
 #include "scene_io/scene_io.h"
@@ -35,8 +36,7 @@ FileReader disk_reader() {
 
 MeshData read_mesh_file(const std::string& path, bool with_materials, const FileReader& read, const Losses& losses,
                         uint64_t& budget) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = image_extension(path);  // lower case
   if (ext != ".obj" && ext != ".ply")
     throw InputError(fmt::format("{}: unsupported mesh file type '{}' (expected .obj or .ply)", path, ext));
   const bool ply = ext == ".ply";

@@ -36,7 +36,8 @@ class MitsubaReader {
     for (pugi::xml_node n : root.children()) {
       if (n.type() != pugi::node_element) continue;
       const std::string tag = n.name();
-      if (tag == "default" || tag == "bsdf" || tag == "shapegroup" || tag == "texture") continue;  // collected / by reference
+      if (tag == "default" || tag == "bsdf" || tag == "texture") continue;  // collected / by reference
+      if (tag == "shape" && doc_.attr(n, "type") == "shapegroup") continue;  // placed by its instances
       if (tag == "shape") {
         read_shape(s, n, nullptr);
       } else if (tag == "sensor") {
@@ -223,13 +224,14 @@ class MitsubaReader {
   uint32_t prototype(Scene& s, const std::string& id, const pugi::xml_node& at) {
     if (const auto it = prototype_of_group_.find(id); it != prototype_of_group_.end()) return it->second;
     const auto def = doc_.ids.find(id);
-    if (def == doc_.ids.end() || std::string(def->second.name()) != "shapegroup")
-      doc_.fail(at, fmt::format("no <shapegroup id=\"{:.60}\">", id));
+    if (def == doc_.ids.end() || std::string(def->second.name()) != "shape" || doc_.attr(def->second, "type") != "shapegroup")
+      doc_.fail(at, fmt::format("no <shape type=\"shapegroup\" id=\"{:.60}\">", id));
     MeshData mesh;
     std::vector<uint32_t> mats;
     for (pugi::xml_node c : def->second.children()) {
       if (c.type() != pugi::node_element) continue;
-      if (std::string(c.name()) != "shape") doc_.fail(c, "a shapegroup holds shapes only");
+      if (std::string(c.name()) != "shape" || doc_.attr(c, "type") == "shapegroup" || doc_.attr(c, "type") == "instance")
+        doc_.fail(c, "a shapegroup holds shapes only (no groups or instances)");
       read_shape(s, c, &mesh, &mats);
     }
     if (mesh.triangles.empty()) doc_.fail(def->second, "the shapegroup has no triangles");

@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_library.h"
@@ -18,11 +19,8 @@ namespace pb {
 
 namespace {
 
-std::string extension_of(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
+// The extension in lower case (image_io's, which means the same for any file).
+std::string extension_of(const std::string& path) { return image_extension(path); }
 
 constexpr std::string_view kReadable[] = {".json", ".obj", ".ply", ".gltf", ".glb", ".xml"};
 

@@ -128,9 +128,9 @@ m = " ".join(str(MATRIX[r][c]) for r in range(3) for c in range(4)) + " 0 0 0 1"
   </sensor>
   <bsdf type="twosided" id="blue"><bsdf type="diffuse"><rgb name="reflectance" value="0.1, 0.2, 0.6"/></bsdf></bsdf>
   <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.75"/></bsdf></bsdf>
-  <shapegroup id="cube">
+  <shape type="shapegroup" id="cube">
     <shape type="obj"><string name="filename" value="cube.obj"/><ref id="blue"/></shape>
-  </shapegroup>
+  </shape>
   <shape type="instance"><ref id="cube"/>
     <transform name="to_world"><rotate y="1" angle="{ROT['angle']}"/><translate x="{MOVE[0]}" y="{MOVE[1]}" z="{MOVE[2]}"/></transform>
   </shape>
