@@ -10,6 +10,7 @@
 #include "accuracy_command.h"
 #include "bench_command.h"
 #include "compare_command.h"
+#include "crosscheck_command.h"
 #include "history_command.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/output_file.h"
@@ -42,6 +43,10 @@ int main(int argc, char** argv) {
   pb::app::add_accuracy_options(*accuracy_cmd, accuracy);
   // Listed for --help only: main() hands `history` over to tools/history before parsing.
   app.add_subcommand("history", "performance history: record runs, change points, dashboard, backfill (tools/history)");
+  pb::app::CrosscheckOptions crosscheck;
+  auto* crosscheck_cmd = app.add_subcommand(
+      "crosscheck", "render a scene with pathbench and Mitsuba 3 and judge them per pixel (same up to noise?)");
+  pb::app::add_crosscheck_options(*crosscheck_cmd, crosscheck);
   pb::app::CompareOptions compare;
   auto* compare_cmd = app.add_subcommand("compare", "judge two benchmark JSON files for regressions (Mann-Whitney U)");
   pb::app::add_compare_options(*compare_cmd, compare);
@@ -66,6 +71,7 @@ int main(int argc, char** argv) {
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
     if (compare_cmd->parsed()) return pb::app::run_compare(compare);
     if (accuracy_cmd->parsed()) return pb::app::run_accuracy(accuracy);
+    if (crosscheck_cmd->parsed()) return pb::app::run_crosscheck(crosscheck);
     if (bench_cmd->parsed()) return pb::app::run_bench(bench, bench_cmd->remaining());
   } catch (const pb::InputError& e) {
     fmt::print(stderr, "pathbench: error: {}\n", e.what());
