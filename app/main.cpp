@@ -10,18 +10,25 @@
 #include "accuracy_command.h"
 #include "bench_command.h"
 #include "compare_command.h"
+#include "crosscheck_command.h"
 #include "history_command.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/output_file.h"
 #include "pathbench/run/world.h"
 #include "render_command.h"
 #include "reproduce_command.h"
+#include "version.h"
 
 int main(int argc, char** argv) {
   // `history` takes its own arguments (Python's argparse), so it is handed over before CLI11 parses.
   if (argc >= 2 && std::string_view(argv[1]) == "history") return pb::app::run_history(argc - 2, argv + 2);
   CLI::App app{"pathbench: CPU/GPU path-tracing benchmark suite"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", [] {
+    std::string text = pb::app::version_text();
+    text.pop_back();  // CLI11 adds the last newline
+    return text;
+  }, "print the version, git revision and build flags");
   pb::app::RenderOptions render;
   auto* render_cmd = app.add_subcommand("render", "render one image and write its run report");
   pb::app::add_render_options(*render_cmd, render);
@@ -37,6 +44,10 @@ int main(int argc, char** argv) {
   pb::app::add_accuracy_options(*accuracy_cmd, accuracy);
   // Listed for --help only: main() hands `history` over to tools/history before parsing.
   app.add_subcommand("history", "performance history: record runs, change points, dashboard, backfill (tools/history)");
+  pb::app::CrosscheckOptions crosscheck;
+  auto* crosscheck_cmd = app.add_subcommand(
+      "crosscheck", "render a scene with pathbench and Mitsuba 3 and judge them per pixel (same up to noise?)");
+  pb::app::add_crosscheck_options(*crosscheck_cmd, crosscheck);
   pb::app::CompareOptions compare;
   auto* compare_cmd = app.add_subcommand("compare", "judge two benchmark JSON files for regressions (Mann-Whitney U)");
   pb::app::add_compare_options(*compare_cmd, compare);
@@ -64,6 +75,7 @@ int main(int argc, char** argv) {
     if (reproduce_cmd->parsed()) return pb::app::run_reproduce(reproduce);
     if (compare_cmd->parsed()) return pb::app::run_compare(compare);
     if (accuracy_cmd->parsed()) return pb::app::run_accuracy(accuracy);
+    if (crosscheck_cmd->parsed()) return pb::app::run_crosscheck(crosscheck);
     if (bench_cmd->parsed()) return pb::app::run_bench(bench, bench_cmd->remaining());
   } catch (const pb::run::PeerFailure& e) {
     return e.code;  // another rank failed; rank 0 printed its message

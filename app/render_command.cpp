@@ -11,19 +11,27 @@
 #include "cli_checks.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
+#include "pathbench/common/report.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/run/ranks_render.h"
 #include "pathbench/run/run.h"
+#include "version.h"
 
 namespace pb::app {
 
 void add_render_options(CLI::App& cmd, RenderOptions& o) {
-  cmd.add_option("--scene", o.scene, "built-in scene name or a .json / .obj file")->capture_default_str();
-  cmd.add_option("--width", o.settings.width, "image width in pixels")->check(non_negative())->capture_default_str();
-  cmd.add_option("--height", o.settings.height, "image height in pixels")->check(non_negative())->capture_default_str();
-  cmd.add_option("--spp", o.settings.spp, "samples per pixel")->check(non_negative())->capture_default_str();
+  cmd.add_option("--scene", o.scene, "built-in scene name or a scene file: .json, .obj, .ply, .gltf, .glb, Mitsuba 3 .xml")
+      ->capture_default_str();
+  cmd.add_flag("--strict", o.strict,
+               "fail (exit 2) when the scene file holds what pathbench does not model (textures, other BSDFs or "
+               "lights), instead of a warning");
+  o.given.width = cmd.add_option("--width", o.settings.width, "image width in pixels")->check(non_negative())->capture_default_str();
+  o.given.height = cmd.add_option("--height", o.settings.height, "image height in pixels")->check(non_negative())->capture_default_str();
+  o.given.spp = cmd.add_option("--spp", o.settings.spp, "samples per pixel")->check(non_negative())->capture_default_str();
   auto* b = cmd.add_option("--bounces", o.settings.max_bounces, "diffuse bounces (the paper: 2)")->capture_default_str();
-  cmd.add_flag("--converged", o.choices.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
+  o.given.bounces = b;
+  o.given.converged =
+      cmd.add_flag("--converged", o.choices.converged, "unbounded path length, ended by Russian roulette")->excludes(b);
   cmd.add_flag("--rr,!--no-rr", o.settings.russian_roulette, "Russian roulette (default: only with --converged)");
   cmd.add_flag("--watertight,!--no-watertight", o.settings.watertight,
                "watertight ray/triangle test (default on; off is faster on the CPU and can leak at edges)");
@@ -90,12 +98,46 @@ void finish_render_options(RenderOptions& o) {
   }
 }
 
+void apply_scene_defaults(const Scene& scene, RenderOptions& o) {
+  const SceneRenderDefaults& d = scene.render_defaults;
+  auto absent = [](const CLI::Option* opt) { return !opt || opt->count() == 0; };
+  std::string taken;
+  auto take = [&](const std::string& what) { taken += (taken.empty() ? "" : ", ") + what; };
+  if (d.width && absent(o.given.width)) o.settings.width = d.width, take(fmt::format("width {}", d.width));
+  if (d.height && absent(o.given.height)) o.settings.height = d.height, take(fmt::format("height {}", d.height));
+  if (d.spp && absent(o.given.spp)) o.settings.spp = d.spp, take(fmt::format("{} spp", d.spp));
+  if (d.max_bounces != SceneRenderDefaults::kUnset && absent(o.given.bounces) && absent(o.given.converged)) {
+    o.settings.max_bounces = d.max_bounces;
+    // Unbounded paths end by Russian roulette, as --converged.
+    if (d.max_bounces < 0) o.settings.russian_roulette = true;
+    take(d.max_bounces < 0 ? std::string("unbounded path length") : fmt::format("{} bounces", d.max_bounces));
+  }
+  if (!taken.empty())
+    fmt::print(stderr, "note: {}: {} from the scene file (options on the command line override them)\n", scene.name, taken);
+}
+
+// What an image must say about where it came from (EXR attributes, PNG text).
+ImageMetadata image_metadata(const RunReport& report) {
+  const nlohmann::json j = report.to_json();
+  nlohmann::json settings;
+  for (const char* key : {"width", "height", "spp", "bounces", "russian_roulette", "sampling", "watertight", "precision",
+                          "device", "strategy", "seed"})
+    if (j.contains(key)) settings[key] = j[key];
+  return {{"Software", fmt::format("pathbench {}", version_number())},
+          {"pathbench:scene", report.scene},
+          {"pathbench:spp", std::to_string(report.settings.spp)},
+          {"pathbench:seed", std::to_string(report.settings.seed)},
+          {"pathbench:settings", settings.dump()},
+          {"pathbench:commit", git_revision()}};
+}
+
 int run_render(RenderOptions& o) {
   // Under mpirun every rank checks its options and loads the scene, and all stop when one fails.
   Scene scene;
   run::on_every_rank([&] {
     finish_render_options(o);
-    scene = load_scene(o.scene);
+    scene = load_scene(o.scene, {.strict = o.strict});
+    apply_scene_defaults(scene, o);
   });
   Film film;  // sized and begun by the run layer, after it has validated the settings
   RunReport report;
@@ -112,9 +154,10 @@ int run_render(RenderOptions& o) {
   // renamed into place, so a failure (a full disk) leaves none of them.
   std::vector<OutputFile> outputs;
   outputs.reserve(3);
-  if (!o.out.empty()) write_image(outputs.emplace_back(o.out), film.mean(), film.width(), film.height());
+  const ImageMetadata metadata = image_metadata(report);
+  if (!o.out.empty()) write_image(outputs.emplace_back(o.out), film.mean(), film.width(), film.height(), metadata);
   if (!o.variance_out.empty())
-    write_image(outputs.emplace_back(o.variance_out), film.variance_of_mean(), film.width(), film.height());
+    write_image(outputs.emplace_back(o.variance_out), film.variance_of_mean(), film.width(), film.height(), metadata);
   if (!o.report.empty()) {
     // The render's own peak, and the whole run's: the images above (the mean, its
     // 8-bit copy, the encoder's buffers) can raise the process's peak above the render's.

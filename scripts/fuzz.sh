@@ -1,28 +1,32 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target for a bounded time and fails on any finding: a crash, a
 # sanitizer report (ASan + UBSan), a leak, a slow input (> 10 s) or one over 2 GB.
-#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | all
+#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | all
 # Builds build-fuzz/ with clang first (-DPATHBENCH_FUZZ=ON). The seed corpus is
 # tests/fuzz/corpus/TARGET (read only); what the fuzzer learns goes to
 # build-fuzz/corpus/TARGET and is kept between runs; a failing input is written to
 # build-fuzz/artifacts/TARGET/ (add it to tests/fuzz/regressions/TARGET/ with the fix).
-# "all" splits SECONDS between the three targets. Extra libFuzzer flags: FUZZ_FLAGS.
+# "all" splits SECONDS between the targets. Extra libFuzzer flags: FUZZ_FLAGS.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
-target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|all SECONDS}
+targets="scene_json obj bench_json ply gltf mitsuba"
+target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|all SECONDS}
 seconds=${2:?usage: scripts/fuzz.sh TARGET SECONDS}
 build=${PATHBENCH_FUZZ_BUILD:-build-fuzz}
 
 if [ "$target" = all ]; then
-  each=$(( seconds / 3 > 0 ? seconds / 3 : 1 ))
-  for t in scene_json obj bench_json; do "$0" "$t" "$each"; done
+  count=$(echo $targets | wc -w)
+  each=$(( seconds / count > 0 ? seconds / count : 1 ))
+  for t in $targets; do "$0" "$t" "$each"; done
   exit 0
 fi
 case "$target" in
-  scene_json|bench_json) dict=tests/fuzz/json.dict ;;
+  scene_json|bench_json|gltf) dict=tests/fuzz/json.dict ;;
   obj) dict=tests/fuzz/obj.dict ;;
-  *) echo "fuzz.sh: unknown target '$target' (scene_json, obj, bench_json or all)" >&2; exit 2 ;;
+  ply) dict=tests/fuzz/ply.dict ;;
+  mitsuba) dict=tests/fuzz/xml.dict ;;
+  *) echo "fuzz.sh: unknown target '$target' ($targets or all)" >&2; exit 2 ;;
 esac
 
 if [ ! -x "$build/bin/fuzz_$target" ] || [ "${FUZZ_REBUILD:-1}" = 1 ]; then

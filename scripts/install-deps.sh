@@ -8,7 +8,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 apt_pkgs=(build-essential cmake ninja-build ccache pkg-config git python3 python3-venv
           libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
-          librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
+          librandom123-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libpugixml-dev
           libfmt-dev libgtest-dev libgmock-dev googletest libbenchmark-dev
           python3-dev  # the `pathbench` Python module (python/; pybind11 from PyPI: tools/requirements.txt)
           libllvm19  # libllvm19: Mitsuba 3 llvm_ad_rgb, the reference and speed comparison

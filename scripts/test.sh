@@ -2,7 +2,7 @@
 # The README's test command: installs what is missing, builds, runs every CTest suite
 # (CPU tests; GPU tests report SKIPPED without a GPU) and the Python tests, then the
 # sanitizer job (scripts/sanitize.sh: unit and CLI tests under ASan + UBSan) and a short
-# fuzz run (scripts/fuzz.sh all 180: three minutes over the three fuzz targets).
+# fuzz run (scripts/fuzz.sh all 180: three minutes over the six fuzz targets).
 # Skip those two locally with PATHBENCH_SKIP_SANITIZE=1 and PATHBENCH_SKIP_FUZZ=1;
 # PATHBENCH_FUZZ_SECONDS sets the fuzz time.
 set -euo pipefail

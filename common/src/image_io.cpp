@@ -83,7 +83,8 @@ class CheckedProxy final : public OIIO::Filesystem::IOProxy {
   int error_ = 0;
 };
 
-void write_oiio(OutputFile& f, const std::string& ext, const std::vector<float>& rgb, unsigned w, unsigned h) {
+void write_oiio(OutputFile& f, const std::string& ext, const std::vector<float>& rgb, unsigned w, unsigned h,
+                const ImageMetadata& metadata) {
   using namespace OIIO;
   const std::string& path = f.path();
   auto out = ImageOutput::create(ext.substr(1));  // the format by its (lower-case) name
@@ -94,6 +95,7 @@ void write_oiio(OutputFile& f, const std::string& ext, const std::vector<float>&
   CheckedProxy proxy(f);
   const bool eight_bit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
   ImageSpec spec(int(w), int(h), 3, eight_bit ? TypeDesc::UINT8 : TypeDesc::FLOAT);
+  for (const auto& [key, value] : metadata) spec.attribute(key, value);
   bool ok = out->set_ioproxy(&proxy) && out->open(f.temp_path(), spec);
   if (ok && eight_bit) {
     std::vector<unsigned char> px(rgb.size());
@@ -139,7 +141,7 @@ bool image_io_has_oiio() { return PATHBENCH_HAVE_OIIO; }
 
 std::string image_extension(const std::string& path) { return extension_of(path); }
 
-void write_image(OutputFile& out, const std::vector<float>& rgb, unsigned w, unsigned h) {
+void write_image(OutputFile& out, const std::vector<float>& rgb, unsigned w, unsigned h, const ImageMetadata& metadata) {
   const std::string& path = out.path();
   if (rgb.size() != size_t(w) * h * 3) throw std::runtime_error(fmt::format("{}: image buffer has the wrong size", path));
   const std::string ext = extension_of(path);
@@ -147,7 +149,7 @@ void write_image(OutputFile& out, const std::vector<float>& rgb, unsigned w, uns
     write_pfm(out, rgb, w, h);
   } else {
 #if PATHBENCH_HAVE_OIIO
-    write_oiio(out, ext, rgb, w, h);
+    write_oiio(out, ext, rgb, w, h, metadata);
 #else
     throw InputError(fmt::format(
         "{}: this build has no OpenImageIO (PATHBENCH_OIIO=OFF), so it cannot write '{}' files; write .pfm instead",
@@ -157,9 +159,10 @@ void write_image(OutputFile& out, const std::vector<float>& rgb, unsigned w, uns
   out.finish();
 }
 
-void write_image(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h) {
+void write_image(const std::string& path, const std::vector<float>& rgb, unsigned w, unsigned h,
+                 const ImageMetadata& metadata) {
   OutputFile out(path);
-  write_image(out, rgb, w, h);
+  write_image(out, rgb, w, h, metadata);
   out.commit();
 }
 

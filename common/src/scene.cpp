@@ -83,7 +83,9 @@ void Scene::finalize() {
   kept.reserve(triangles.size());
   kept_mat.reserve(triangles.size());
   dropped_triangles = 0;
+  std::vector<uint32_t> kept_before(instances.empty() ? 0 : triangles.size() + 1, 0);
   for (size_t i = 0; i < triangles.size(); ++i) {
+    if (!kept_before.empty()) kept_before[i] = uint32_t(kept.size());
     const Triangle& t = triangles[i];
     for (uint32_t k : t.v)
       if (k >= positions.size())
@@ -107,6 +109,16 @@ void Scene::finalize() {
     }
     kept.push_back(t);
     kept_mat.push_back(material_ids[i]);
+  }
+  if (!kept_before.empty()) kept_before[triangles.size()] = uint32_t(kept.size());
+  if (dropped_triangles && !instances.empty()) {
+    // Instance ranges follow the triangles that were kept: kept_before[i] counts the
+    // kept triangles with index below i.
+    for (SceneInstance& in : instances) {
+      const uint32_t end = in.first_triangle + in.triangle_count;
+      in.first_triangle = kept_before[in.first_triangle];
+      in.triangle_count = kept_before[end] - in.first_triangle;
+    }
   }
   if (dropped_triangles)
     fmt::print(stderr, "warning: {}: dropped {} zero-area triangle{}\n", name, dropped_triangles,

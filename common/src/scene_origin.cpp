@@ -79,6 +79,8 @@ Scene transformed(Scene s, float scale, Vec3f offset) {
   // In the user's coordinates (traced + origin is exact, see above), then rebased anew.
   for (Vec3f& p : s.positions) p = (p + s.origin) * scale + offset;
   s.camera.position = (s.camera.position + s.origin) * scale + offset;
+  for (SceneInstance& in : s.instances)
+    in.to_world = Affine::translate(offset.x, offset.y, offset.z) * Affine::scale(scale, scale, scale) * in.to_world;
   s.origin = {0, 0, 0};
   s.finalize();
   return s;

@@ -31,7 +31,8 @@ using Json = nlohmann::ordered_json;  // keeps the materials in file order
 
 class JsonSceneReader {
  public:
-  JsonSceneReader(std::string path, const FileReader& read) : path_(std::move(path)), read_(read) {}
+  JsonSceneReader(std::string path, const FileReader& read, const Losses& losses)
+      : path_(std::move(path)), read_(read), losses_(losses) {}
 
   Scene read(const std::string& text) {
     Json root;
@@ -51,8 +52,9 @@ class JsonSceneReader {
     Scene s;
     s.name = path_;
     read_camera(s, member(root, "camera", ""));
-    const Json& materials = member(root, "materials", "");
-    if (!materials.is_object() || materials.empty())
+    // Optional when every mesh brings its own (MTL) materials.
+    const Json& materials = root.contains("materials") ? root["materials"] : Json::object();
+    if (!materials.is_object())
       fail("materials", "expected an object of named materials, e.g. {\"white\": {\"albedo\": [0.5, 0.5, 0.5]}}");
     for (const auto& [name, m] : materials.items()) scenes::append_material(s, name, read_material(m, "materials." + name));
     if (root.contains("meshes")) {
@@ -71,6 +73,7 @@ class JsonSceneReader {
  private:
   std::string path_;
   const FileReader& read_;
+  const Losses& losses_;
   mutable uint64_t mesh_bytes_ = 0;
   mutable std::unordered_map<std::string, uint32_t> material_index_;  // name -> first material of that name  // all mesh files read so far: one budget for the scene
 
@@ -198,35 +201,115 @@ class JsonSceneReader {
     s.camera = Camera::look_at(eye, target, up, fov);
   }
 
-  void read_mesh(Scene& s, const Json& m, const std::string& field) const {
-    allow_keys(object(m, field), field, {"file", "material", "transform"});
-    const std::string file = string(member(m, "file", field), field + ".file");
-    const uint32_t mat = material(s, member(m, "material", field), field + ".material");
-    Vec3f scale{1, 1, 1}, translate{0, 0, 0};
-    if (m.contains("transform")) {
-      const Json& t = m["transform"];
-      const std::string tf = field + ".transform";
-      allow_keys(object(t, tf), tf, {"scale", "translate"});
-      if (t.contains("scale")) {
-        const Json& sc = t["scale"];
-        scale = sc.is_array() ? vec3(sc, tf + ".scale") : Vec3f{1, 1, 1} * number(sc, tf + ".scale");
-        if (scale.x == 0 || scale.y == 0 || scale.z == 0) fail(tf + ".scale", "a zero scale flattens the mesh");
-      }
-      if (t.contains("translate")) translate = vec3(t["translate"], tf + ".translate");
+  // One transform: {"scale": s or [sx, sy, sz], "rotate": {"axis": [x, y, z], "angle":
+  // degrees}, "translate": [x, y, z]} applied in that order (p' = T R S p), or {"matrix":
+  // 3x4 or 4x4 rows}; or an array of such objects applied first to last.
+  Affine read_transform(const Json& t, const std::string& tf) const {
+    if (t.is_array()) {
+      Affine a;
+      for (size_t i = 0; i < t.size(); ++i) a = read_transform(object(t[i], fmt::format("{}[{}]", tf, i)), fmt::format("{}[{}]", tf, i)) * a;
+      return a;
     }
-    const fs::path obj = fs::path(path_).parent_path() / file;
-    if (!read_.exists(obj.string())) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, obj.string()));
+    allow_keys(object(t, tf), tf, {"scale", "rotate", "translate", "matrix"});
+    Affine a;
+    if (t.contains("matrix")) {
+      if (t.size() != 1) fail(tf + ".matrix", "cannot be combined with scale, rotate or translate in one object (use an array of transforms)");
+      const Json& m = t["matrix"];
+      const std::string mf = tf + ".matrix";
+      if (!m.is_array() || (m.size() != 3 && m.size() != 4)) fail(mf, "expected 3 or 4 rows of 4 numbers, got " + got(m));
+      double rows[4][4];
+      for (size_t r = 0; r < m.size(); ++r) {
+        const std::string rf = fmt::format("{}[{}]", mf, r);
+        if (!m[r].is_array() || m[r].size() != 4) fail(rf, "expected a row of 4 numbers, got " + got(m[r]));
+        for (size_t c = 0; c < 4; ++c) rows[r][c] = number(m[r][c], fmt::format("{}[{}]", rf, c));
+      }
+      if (m.size() == 4 && !(rows[3][0] == 0 && rows[3][1] == 0 && rows[3][2] == 0 && rows[3][3] == 1))
+        fail(mf + "[3]", "the last row of an affine transform must be [0, 0, 0, 1] (projective transforms are not supported)");
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) a.m[r][c] = rows[r][c];
+      if (!(std::fabs(a.determinant()) > 0)) fail(mf, "is singular: it flattens the mesh");
+      return a;
+    }
+    if (t.contains("scale")) {
+      const Json& sc = t["scale"];
+      const Vec3f scale = sc.is_array() ? vec3(sc, tf + ".scale") : Vec3f{1, 1, 1} * number(sc, tf + ".scale");
+      if (scale.x == 0 || scale.y == 0 || scale.z == 0) fail(tf + ".scale", "a zero scale flattens the mesh");
+      a = Affine::scale(scale.x, scale.y, scale.z);
+    }
+    if (t.contains("rotate")) {
+      const std::string rf = tf + ".rotate";
+      const Json& r = t["rotate"];
+      allow_keys(object(r, rf), rf, {"axis", "angle"});
+      const Vec3f axis = vec3(member(r, "axis", rf), rf + ".axis");
+      if (is_zero(axis)) fail(rf + ".axis", "is zero: no axis to rotate about");
+      a = Affine::rotate(axis.x, axis.y, axis.z, number(member(r, "angle", rf), rf + ".angle")) * a;
+    }
+    if (t.contains("translate")) {
+      const Vec3f d = vec3(t["translate"], tf + ".translate");
+      a = Affine::translate(d.x, d.y, d.z) * a;
+    }
+    return a;
+  }
+
+  // {"file": OBJ or PLY, "material": name (optional for an OBJ: its own MTL materials),
+  // "transform": T} or, instanced, {"file", "material", "instances": [T, T, ...]}.
+  void read_mesh(Scene& s, const Json& m, const std::string& field) const {
+    allow_keys(object(m, field), field, {"file", "material", "transform", "instances"});
+    const std::string file = string(member(m, "file", field), field + ".file");
+    const bool own_materials = !m.contains("material");
+    const uint32_t mat = own_materials ? 0 : material(s, m["material"], field + ".material");
+    if (m.contains("transform") && m.contains("instances"))
+      fail(field + ".instances", "give either \"transform\" (one placement) or \"instances\" (several), not both");
+    std::vector<Affine> placements;
+    if (m.contains("instances")) {
+      const Json& list = array(m["instances"], field + ".instances");
+      if (list.empty()) fail(field + ".instances", "is empty: give at least one transform");
+      for (size_t i = 0; i < list.size(); ++i)
+        placements.push_back(read_transform(list[i], fmt::format("{}.instances[{}]", field, i)));
+    } else {
+      placements.push_back(m.contains("transform") ? read_transform(m["transform"], field + ".transform") : Affine());
+    }
+    const fs::path path = fs::path(path_).parent_path() / file;
+    if (!read_.exists(path.string())) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, path.string()));
+    MeshData mesh;
     try {
-      const std::string text = read_.read(obj.string(), "mesh file (OBJ)", limits::kMaxMeshBytes);
-      mesh_bytes_ += text.size();
-      if (mesh_bytes_ > limits::kMaxMeshBytes)
-        fail(field + ".file", fmt::format("the mesh files (OBJ) of one scene are limited to {} in all",
-                                          format_bytes(limits::kMaxMeshBytes)));
-      append_obj_mesh(s, obj.string(), text, scale, translate, mat);
+      mesh = read_mesh_file(path.string(), own_materials, read_, losses_, mesh_bytes_);
     } catch (const InputError& e) {
       if (std::string_view(e.what()).rfind(path_ + ": ", 0) == 0) throw;  // already names this file
       fail(field, e.what());
     }
+    std::vector<uint32_t> mats{mat};
+    if (own_materials) mats = own_material_ids(s, mesh, file);
+    if (m.contains("instances")) {
+      const uint32_t proto = add_prototype(s, file, mesh, mats);
+      for (const Affine& a : placements) add_instance(s, proto, a);
+    } else {
+      append_mesh(s, mesh, placements[0], mats);
+    }
+  }
+
+  // A mesh without "material": its OBJ's MTL materials join the scene as "FILE:NAME";
+  // faces without one (and PLY meshes) get a grey default, with a note.
+  std::vector<uint32_t> own_material_ids(Scene& s, const MeshData& mesh, const std::string& file) const {
+    std::vector<uint32_t> scene_ids;
+    for (size_t i = 0; i < mesh.materials.size(); ++i)
+      scene_ids.push_back(scenes::append_material(s, file + ":" + mesh.material_names[i], mesh.materials[i]));
+    std::vector<uint32_t> ids(mesh.triangles.size());
+    uint32_t grey = ~0u;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const int m = mesh.material_ids[i];
+      if (m >= 0) {
+        ids[i] = scene_ids[size_t(m)];
+        continue;
+      }
+      if (grey == ~0u) {
+        grey = scenes::add_material(s, file + ":default", {0.5f, 0.5f, 0.5f});
+        fmt::print(stderr, "note: {}: mesh '{}' has faces without a material (no \"material\" given, none from an MTL "
+                           "file); they get a grey default (albedo 0.5)\n", path_, file);
+      }
+      ids[i] = grey;
+    }
+    return ids;
   }
 
   void read_triangles(Scene& s, const Json& g, const std::string& field) const {
@@ -262,17 +345,17 @@ class JsonSceneReader {
 
 }  // namespace
 
-Scene parse_scene_json(const std::string& path, const std::string& text, const FileReader& read) {
-  return JsonSceneReader(path, read).read(text);
+Scene parse_scene_json(const std::string& path, const std::string& text, const FileReader& read, const Losses& losses) {
+  return JsonSceneReader(path, read, losses).read(text);
 }
 
 }  // namespace pb::scene_io
 
 namespace pb {
 
-Scene load_scene_json(const std::string& path) {
+Scene load_scene_json(const std::string& path, bool strict) {
   return scene_io::parse_scene_json(path, read_input_file(path, "scene file (JSON)", limits::kMaxSceneJsonBytes),
-                                    scene_io::disk_reader());
+                                    scene_io::disk_reader(), scene_io::Losses(strict));
 }
 
 }  // namespace pb

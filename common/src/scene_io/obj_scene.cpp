@@ -72,14 +72,19 @@ struct UsedMaterial {
   std::string name;
   size_t line;
 };
+struct ObjCheck {
+  std::vector<UsedMaterial> used;  // the `usemtl` names with their lines
+  uint64_t normals = 0, texcoords = 0;  // `vn` and `vt` lines (not modelled)
+};
 
-// Checks the OBJ text line by line; returns the `usemtl` names with their lines.
-std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::string& text, bool with_materials,
+// Checks the OBJ text line by line.
+ObjCheck check_obj_text(const std::string& path, const std::string& text, bool with_materials,
                                          const FileReader& files) {
   auto fail = [&](size_t line, const std::string& what) {
     throw InputError(fmt::format("{}:{}: {}", path, line, what));
   };
-  std::vector<UsedMaterial> used;
+  ObjCheck check;
+  std::vector<UsedMaterial>& used = check.used;
   int64_t vertices = 0;
   int64_t max_ref = 0;  // the largest absolute vertex index, and its line
   size_t max_ref_line = 0;
@@ -110,6 +115,8 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
           fail(line_no, fmt::format("vertex coordinate '{:.40}' is NaN or infinite (or too large for a float)", tok[i]));
       }
       if (kw == "v") ++vertices;
+      if (kw == "vn") ++check.normals;
+      if (kw == "vt") ++check.texcoords;
     } else if (kw == "f" || kw == "l" || kw == "p") {
       const size_t n = tok.size() - 1;
       if (kw == "f" && n < 3) fail(line_no, "a face needs at least 3 vertices");
@@ -163,7 +170,7 @@ std::vector<UsedMaterial> check_obj_text(const std::string& path, const std::str
   }
   if (max_ref > vertices)
     fail(max_ref_line, fmt::format("face refers to vertex {}, but the file has only {} vertices", max_ref, vertices));
-  return used;
+  return check;
 }
 
 // tinyobjloader's number parser overflows a signed int (undefined behaviour) on an
@@ -217,8 +224,12 @@ class MtlReader : public tinyobj::MaterialReader {
   uint64_t used_ = 0;
 };
 
-ObjData read_obj(const std::string& path, const std::string& text, bool with_materials, const FileReader& read) {
-  const std::vector<UsedMaterial> used = check_obj_text(path, text, with_materials, read);
+ObjData read_obj(const std::string& path, const std::string& text, bool with_materials, const FileReader& read,
+                 const Losses& losses) {
+  const ObjCheck check = check_obj_text(path, text, with_materials, read);
+  const std::vector<UsedMaterial>& used = check.used;
+  if (check.normals)
+    losses.report(path, fmt::format("{} vertex normals (vn): shading uses the geometric normal", check.normals));
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
@@ -287,70 +298,41 @@ Vec3f clamp01(const tinyobj::real_t* c) {
   return {one(float(c[0])), one(float(c[1])), one(float(c[2]))};
 }
 
-// A camera that frames the bounding sphere of [lo, hi], from the front (+z) and a
-// little above, as OBJ models are usually modelled with +y up.
-Camera framing_camera(Vec3f lo, Vec3f hi) {
-  const Vec3f centre = (lo + hi) * 0.5f;
-  const float radius = pmax(0.5f * length(hi - lo), 1e-6f);
-  const float fov_deg = 40.0f;
-  const float distance = 1.05f * radius / std::sin(0.5f * fov_deg * kPi<float> / 180.0f);
-  const Vec3f dir = normalize(Vec3f{0, 0.25f, 1});
-  return Camera::look_at(centre + dir * distance, centre, {0, 1, 0}, fov_deg);
+// What an MTL material holds beyond Kd and Ke, named for Losses.
+void report_mtl_losses(const std::string& path, const tinyobj::material_t& m, const Losses& losses) {
+  const std::pair<const char*, const std::string*> maps[] = {
+      {"map_Kd", &m.diffuse_texname},   {"map_Ks", &m.specular_texname}, {"map_Ka", &m.ambient_texname},
+      {"map_Ns", &m.specular_highlight_texname}, {"bump", &m.bump_texname}, {"map_d", &m.alpha_texname},
+      {"disp", &m.displacement_texname}, {"refl", &m.reflection_texname}, {"norm", &m.normal_texname},
+      {"map_Ke", &m.emissive_texname},  {"map_Pr", &m.roughness_texname}, {"map_Pm", &m.metallic_texname}};
+  for (const auto& [key, name] : maps)
+    if (!name->empty()) losses.report(path, fmt::format("material '{:.80}': texture {} '{:.80}'", m.name, key, *name));
+  if (m.specular[0] > 0 || m.specular[1] > 0 || m.specular[2] > 0)
+    losses.report(path, fmt::format("material '{:.80}': specular reflection Ks (diffuse only)", m.name));
+  if (m.dissolve < 1) losses.report(path, fmt::format("material '{:.80}': transparency d/Tr", m.name));
 }
-
-// A quad light above the top of [lo, hi], facing down, overhanging the bounds by a
-// quarter of their diagonal on every side (so the sides catch some light too), and
-// bright enough that an upward-facing surface of albedo 0.5 below its middle comes
-// out at about 0.8.
-void add_default_light(Scene& s, Vec3f lo, Vec3f hi) {
-  const Vec3f size = hi - lo, centre = (lo + hi) * 0.5f;
-  const float diag = pmax(length(size), 1e-6f);
-  const float hx = 0.5f * size.x + 0.25f * diag, hz = 0.5f * size.z + 0.25f * diag;
-  const float y = hi.y + 0.25f * diag;
-  // The irradiance below the middle of the quad at height h is about pi L a^2 / (a^2 +
-  // h^2) with a^2 = hx hz; the radiance reflected at albedo 0.5 is half that over pi.
-  const float a2 = hx * hz, h = 0.25f * diag;
-  const float radiance = 1.6f * (a2 + h * h) / a2;
-  const uint32_t light = scenes::add_material(s, "default-light", {0, 0, 0}, {radiance, radiance, radiance});
-  using scenes::add_vertex;
-  scenes::add_quad(s, add_vertex(s, {centre.x - hx, y, centre.z - hz}), add_vertex(s, {centre.x + hx, y, centre.z - hz}),
-                   add_vertex(s, {centre.x + hx, y, centre.z + hz}), add_vertex(s, {centre.x - hx, y, centre.z + hz}),
-                   light);
-}
-
 
 }  // namespace
 
-FileReader disk_reader() {
-  return {[](const std::string& path, const char* what, uint64_t max_bytes) {
-            return read_input_file(path, what, max_bytes);
-          },
-          // With an error code: a symlink loop or a long name is read_input_file's to report.
-          [](const std::string& path) {
-            std::error_code ec;
-            return fs::exists(path, ec) || ec;
-          }};
+MeshData read_obj_mesh(const std::string& path, const std::string& text, bool with_materials, const FileReader& read,
+                       const Losses& losses) {
+  ObjData obj = read_obj(path, text, with_materials, read, losses);
+  MeshData mesh{std::move(obj.positions), std::move(obj.triangles), std::move(obj.material_ids), {}, {}};
+  for (const tinyobj::material_t& m : obj.materials) {
+    report_mtl_losses(path, m, losses);
+    mesh.materials.push_back({clamp01(m.diffuse), {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])}});
+    mesh.material_names.push_back(m.name);
+  }
+  return mesh;
 }
 
-void append_obj_mesh(Scene& s, const std::string& path, const std::string& text, Vec3f scale, Vec3f translate,
-                     uint32_t material) {
-  const ObjData mesh = read_obj(path, text, false, disk_reader());
-  if (s.triangles.size() + mesh.triangles.size() > limits::kMaxTriangles)
-    throw InputError(fmt::format("the scene has more than {} triangles (the supported maximum)", limits::kMaxTriangles));
-  const uint32_t base = uint32_t(s.positions.size());
-  for (const Vec3f& p : mesh.positions) s.positions.push_back(p * scale + translate);
-  for (const Triangle& t : mesh.triangles) scenes::add_triangle(s, base + t.v[0], base + t.v[1], base + t.v[2], material);
-}
-
-Scene parse_scene_obj(const std::string& path, const std::string& text, const FileReader& read) {
-  ObjData mesh = read_obj(path, text, true, read);
+Scene parse_scene_obj(const std::string& path, const std::string& text, const FileReader& read, const Losses& losses) {
+  MeshData mesh = read_obj_mesh(path, text, true, read, losses);
   Scene s;
   s.name = path;
   s.positions = std::move(mesh.positions);
-  for (const tinyobj::material_t& m : mesh.materials)
-    scenes::add_material(s, m.name, clamp01(m.diffuse), {float(m.emission[0]), float(m.emission[1]), float(m.emission[2])});
+  for (size_t i = 0; i < mesh.materials.size(); ++i) scenes::append_material(s, mesh.material_names[i], mesh.materials[i]);
   uint32_t default_material = ~0u;
-  bool has_emitter = false;
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {
     uint32_t mat;
     if (mesh.material_ids[i] >= 0) {
@@ -359,31 +341,10 @@ Scene parse_scene_obj(const std::string& path, const std::string& text, const Fi
       if (default_material == ~0u) default_material = scenes::add_material(s, "default", {0.5f, 0.5f, 0.5f});
       mat = default_material;
     }
-    has_emitter = has_emitter || max_component(s.materials[mat].emission) > 0;
     const Triangle& t = mesh.triangles[i];
     scenes::add_triangle(s, t.v[0], t.v[1], t.v[2], mat);
   }
-  // Bounds of what the faces use (finalize() computes the same later, after the light).
-  Vec3f lo = s.positions[s.triangles[0].v[0]], hi = lo;
-  for (const Triangle& t : s.triangles)
-    for (uint32_t k : t.v) {
-      lo = vmin(lo, s.positions[k]);
-      hi = vmax(hi, s.positions[k]);
-    }
-  if (!is_finite(lo) || !is_finite(hi))
-    throw InputError(fmt::format("{}: a vertex has a NaN or infinite coordinate", path));
-  // The camera and the default light sit a few model sizes away from the model, so a
-  // framed model must lie well inside the supported range (its 1/8).
-  const double reach = limits::kMaxCoordinate / 8;
-  if (std::max(max_component(vmax(hi, -lo)), 0.0f) > reach)
-    throw InputError(fmt::format("{}: the model reaches {:g}; an OBJ scene is framed automatically, so its "
-                                 "coordinates must lie within +-{:g} (1/8 of the supported range +-{:g})",
-                                 path, double(max_component(vmax(hi, -lo))), reach, limits::kMaxCoordinate));
-  s.camera = framing_camera(lo, hi);
-  if (!has_emitter) {
-    add_default_light(s, lo, hi);
-    fmt::print(stderr, "note: {}: no emissive material (MTL Ke); added a default area light above the model\n", path);
-  }
+  frame_bare_mesh(s, path, true, "MTL Ke");
   s.finalize();
   return s;
 }
@@ -391,8 +352,8 @@ Scene parse_scene_obj(const std::string& path, const std::string& text, const Fi
 }  // namespace pb::scene_io
 
 namespace pb {
-Scene load_scene_obj(const std::string& path) {
+Scene load_scene_obj(const std::string& path, bool strict) {
   return scene_io::parse_scene_obj(path, read_input_file(path, "mesh file (OBJ)", limits::kMaxMeshBytes),
-                                   scene_io::disk_reader());
+                                   scene_io::disk_reader(), scene_io::Losses(strict));
 }
 }  // namespace pb

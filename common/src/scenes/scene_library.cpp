@@ -11,11 +11,6 @@ namespace pb {
 
 namespace {
 
-bool ends_with(const std::string& s, const char* suffix) {
-  std::string_view sv(s), suf(suffix);
-  return sv.size() >= suf.size() && sv.substr(sv.size() - suf.size()) == suf;
-}
-
 // Parses the comma-separated numbers after "name:".
 std::vector<double> parse_params(const std::string& spec, const std::string& params, size_t expected_max) {
   std::vector<double> out;
@@ -66,16 +61,17 @@ const std::vector<BuiltinSceneInfo>& builtin_scenes() {
   return list;
 }
 
-Scene load_scene(const std::string& spec) {
+Scene load_scene(const std::string& spec, const SceneLoadOptions& options) {
   if (spec.empty()) throw InputError("--scene: empty scene name");
-  if (ends_with(spec, ".json") || ends_with(spec, ".obj") || spec.find('/') != std::string::npos) {
+  // A file: a known extension, a '/', or any extension on a name without the colon of a
+  // built-in's parameters ("furnace:0.5" has an "extension" too).
+  if (is_scene_file_name(spec) || spec.find('/') != std::string::npos ||
+      (spec.find(':') == std::string::npos && std::filesystem::path(spec).has_extension())) {
     // exists() with an error code: a symlink loop or a long name is read_input_file's
     // to report, not an exception here.
     std::error_code ec;
     if (!std::filesystem::exists(spec, ec) && !ec) throw InputError(fmt::format("{}: no such file", spec));
-    if (ends_with(spec, ".json")) return load_scene_json(spec);
-    if (ends_with(spec, ".obj")) return load_scene_obj(spec);
-    throw InputError(fmt::format("{}: unknown scene file type (expected .json or .obj)", spec));
+    return load_scene_file(spec, options.strict);
   }
   const size_t colon = spec.find(':');
   const std::string base = spec.substr(0, colon);
@@ -100,7 +96,7 @@ Scene load_scene(const std::string& spec) {
   }
   std::string names;
   for (const auto& b : builtin_scenes()) names += (names.empty() ? "" : ", ") + b.name;
-  throw InputError(fmt::format("unknown scene '{}' (built-ins: {}; or a .json / .obj file)", spec, names));
+  throw InputError(fmt::format("unknown scene '{}' (built-ins: {}; or a scene file: .json, .obj, .ply, .gltf, .glb, .xml)", spec, names));
 }
 
 }  // namespace pb

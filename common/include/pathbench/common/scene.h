@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/common/affine.h"
 #include "pathbench/common/camera.h"
 #include "pathbench/common/math.h"
 #include "pathbench/common/ray_offset.h"
@@ -62,6 +63,31 @@ struct SceneView {
   PB_HD const Material& material_of(uint32_t tri) const { return materials[material_ids[tri]]; }
 };
 
+// Instancing as a scene file describes it (JSON "instances", Mitsuba shapegroup and
+// instance, a glTF mesh used by several nodes). Loading expands every instance into the
+// flat arrays (the tracers see triangles only); this record is kept so that a tracer
+// can build Embree instances or a two-level BVH from it instead.
+struct ScenePrototype {
+  std::string name;
+  std::vector<Vec3f> positions;  // the prototype's own coordinates
+  std::vector<Triangle> triangles;
+  std::vector<uint32_t> material_ids;
+};
+struct SceneInstance {
+  uint32_t prototype;        // index into Scene::prototypes
+  Affine to_world;           // prototype coordinates -> user coordinates
+  uint32_t first_triangle;   // where its expansion sits in Scene::triangles (after finalize)
+  uint32_t triangle_count;   // its triangles kept there (finalize drops zero-area ones)
+};
+
+// What a scene file asks of the render (Mitsuba's film, sampler and integrator): the
+// render command uses each unless its option is given. 0 / kUnset: the file says nothing.
+struct SceneRenderDefaults {
+  static constexpr int kUnset = -2;
+  uint32_t width = 0, height = 0, spp = 0;
+  int max_bounces = kUnset;  // -1: unbounded (Mitsuba max_depth -1)
+};
+
 struct Scene {
   std::string name;    // built-in name or file path
   std::vector<Vec3f> positions;
@@ -70,6 +96,9 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<std::string> material_names;
   Camera camera{};
+  std::vector<ScenePrototype> prototypes;
+  std::vector<SceneInstance> instances;
+  SceneRenderDefaults render_defaults;
 
   // Derived by finalize().
   std::vector<uint32_t> emitters;

@@ -14,9 +14,16 @@ struct BuiltinSceneInfo {
 };
 const std::vector<BuiltinSceneInfo>& builtin_scenes();
 
-// "paper-cornell", "furnace:0.5", a .json scene file or a bare .obj mesh. The result
-// is finalized. Throws InputError naming the scene or file and what is wrong.
-Scene load_scene(const std::string& name_or_path);
+// How scene files are read. strict: what a file holds that pathbench does not model (a
+// texture, another BSDF or light) is an InputError instead of a warning.
+struct SceneLoadOptions {
+  bool strict = false;
+};
+
+// "paper-cornell", "furnace:0.5", or a scene file: .json, .obj, .ply, .gltf, .glb or
+// Mitsuba 3 .xml. The result is finalized. Throws InputError naming the scene or file
+// (and, for a file, its format) and what is wrong.
+Scene load_scene(const std::string& name_or_path, const SceneLoadOptions& options = {});
 
 // Built-ins, also callable directly.
 Scene make_paper_cornell();
@@ -36,8 +43,12 @@ Scene make_paper_cornell_ico(int level);
 // 0.5): about `triangles` in all (the sphere takes the remainder; at least the box's 14).
 Scene make_scaling(uint64_t triangles);
 
-// Scene files (scene_file.cpp).
-Scene load_scene_json(const std::string& path);
-Scene load_scene_obj(const std::string& path);
+// Scene files (common/src/scene_io/), each by its format.
+Scene load_scene_json(const std::string& path, bool strict = false);
+Scene load_scene_obj(const std::string& path, bool strict = false);
+// By the file's extension (any case); InputError for one pathbench does not read.
+Scene load_scene_file(const std::string& path, bool strict = false);
+// True when `name` ends in an extension of a scene file pathbench reads.
+bool is_scene_file_name(const std::string& name);
 
 }  // namespace pb
