@@ -2,10 +2,10 @@
 // simd8.h, under a target that adds FMA.) The tiny-scene test (tiny_scene.h): kLanes rays
 // against every triangle of a TinyScene, lanes = rays.
 //
-// Per triangle it evaluates Embree 3's robust Pluecker test in Embree's own order of
+// Per triangle it evaluates Embree 3's robust Pluecker test in Embree's order of
 // operations (vertices relative to the ray origin, edge functions U, V, W as
-// dot(cross(e, v + v'), D) with FMA, the normal by stable_triangle_normal, den and T
-// doubled), then decides with margins instead of Embree's exact comparisons:
+// dot(cross(e, v + v'), D) with FMA, den and T doubled; the normal as cross(e0, e1)),
+// then decides with margins instead of Embree's exact comparisons:
 //   inside  all of U, V, W beyond +-m with one sign     outside  some beyond +m, some beyond -m
 //   front   T (sign of den applied) > band               behind   < -band
 //   before  t < tfar (1 - 2^-20) - err                    beyond   t > tfar (1 + 2^-20) + err
@@ -18,8 +18,8 @@
 // Both computations start from the same rounded vertices (v = p - o, e = v - v', v + v'
 // are single IEEE operations in either), so they differ only in how the products are
 // rounded: m = 2^-16 E M |D|_1 (E: this triangle's largest edge component, M: a bound on
-// |vertex - origin| over the scene), band = 2^-20 M_tri (|Ng|_1 + 3 E^2) (M_tri: this
-// triangle's largest |vertex - origin| component), t's error band / |den| + 2^-20 t.
+// |vertex - origin| over the scene), band = 2^-20 |v0|_inf (|Ng|_1 + 3 E^2), t's error
+// band / |den| + 2^-20 t.
 // cpu/NOTES.md derives them.
 namespace pb::cpu::PB_SIMD_NS {
 
@@ -38,17 +38,6 @@ inline FV emb_dot(V3 a, V3 b) { return fmadd(a.x, b.x, fmadd(a.y, b.y, a.z * b.z
 inline V3 emb_cross(V3 a, V3 b) {
   return {fmsub(a.y, b.z, a.z * b.y), fmsub(a.z, b.x, a.x * b.z), fmsub(a.x, b.y, a.y * b.x)};
 }
-// Embree's stable_triangle_normal(a, b, c): per component, the cross product of the
-// pair whose subtracted product is smaller.
-inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
-  const FV ab_x = a.z * b.y, ab_y = a.x * b.z, ab_z = a.y * b.x;
-  const FV bc_x = b.z * c.y, bc_y = b.x * c.z, bc_z = b.y * c.x;
-  const V3 cab{fmsub(a.y, b.z, ab_x), fmsub(a.z, b.x, ab_y), fmsub(a.x, b.y, ab_z)};
-  const V3 cbc{fmsub(b.y, c.z, bc_x), fmsub(b.z, c.x, bc_y), fmsub(b.x, c.y, bc_z)};
-  return {select(abs(ab_x) < abs(bc_x), cab.x, cbc.x), select(abs(ab_y) < abs(bc_y), cab.y, cbc.y),
-          select(abs(ab_z) < abs(bc_z), cab.z, cbc.z)};
-}
-
 struct TinyResult {
   FV best, best_lo, best_hi;  // nearest proven hit's distance and its error interval
   FV other_lo;       // lowest bottom of any other proven hit's or doubt's interval
@@ -83,7 +72,9 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     const FV m = m_scale * tr.edge;
     const IV outside = (hi > m) & (lo < -m);
     if (lane_mask(~outside) == 0) continue;  // (movemask: any() tests lane by lane)
-    const V3 ng = emb_stable_normal(e0, e1, e2);
+    // cross(e0, e1): Embree's stable_triangle_normal picks, per component, between it
+    // and cross(e1, e2), equal but for rounding (|difference| << E^2, inside `band`).
+    const V3 ng = emb_cross(e0, e1);
     FV den = emb_dot(ng, d);
     den = den + den;
     FV T = emb_dot(v0, ng);
@@ -91,11 +82,10 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     const FV abs_den = abs(den);
     const FV Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
     const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
-    // T's error: the rounding of the vertices (relative to M_tri, this triangle's largest
-    // |vertex - origin| component) carried through the edges into Ng, and of the dot.
-    const FV m_tri = vmax(vmax(vmax(abs(v0.x), abs(v0.y)), vmax(abs(v0.z), abs(v1.x))),
-                          vmax(vmax(abs(v1.y), abs(v1.z)), vmax(vmax(abs(v2.x), abs(v2.y)), abs(v2.z))));
-    const FV band = 0x1p-20f * m_tri * (ng1 + 3.0f * tr.edge * tr.edge);
+    // T = 2 dot(v0, Ng): the two computations' Ng differ by rounding relative to E^2, and
+    // the dot by rounding relative to |v0| |Ng|.
+    const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
+    const FV band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
     const IV grazing = abs_den <= 0x1p-15f * ng1 * d1;        // |den| <= 2 |Ng|_1 |D|_1: 2^-16 of that
     const IV inside = ((lo > m) | (hi < -m)) & ~grazing;
     const IV front = Ts > band, behind = Ts < -band;
