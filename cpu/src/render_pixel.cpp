@@ -17,6 +17,7 @@
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
 #include "strategies.h"
+#include "tiny_scene.h"
 
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly
@@ -64,10 +65,11 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
 // rtcOccluded1 each (notes/cpu-performance.md measures both).
 constexpr bool kPixelPackets = true;
 
-// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet.
+// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet; with `tiny`, the
+// tiny-scene test first (tiny_scene.h).
 template <int W>
-void closest_packet(const EmbreeScene& e, RTCIntersectContext& ctx, const PathState<float>* st, const int* idx, int n,
-                    uint32_t* prim) {
+void closest_packet(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
+                    const PathState<float>* st, const int* idx, int n, uint32_t* prim) {
   alignas(64) RTCRayHitNt<W> p;
   alignas(64) int valid[W];
   for (int j = 0; j < W; ++j) {
@@ -75,18 +77,26 @@ void closest_packet(const EmbreeScene& e, RTCIntersectContext& ctx, const PathSt
     set_lane(p.ray, j, st[idx[j < n ? j : 0]].ray, kInfinity);
     p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
   }
+  if (tiny) {
+    tiny_closest<W>(k, *tiny, e, ctx, p, n, prim);
+    return;
+  }
   intersect_packet(valid, e.handle(), &ctx, p);
   for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
 }
 // Whether each shadow ray q[idx[0..n)] (n <= W) is blocked, as one packet.
 template <int W>
-void occluded_packet_of(const EmbreeScene& e, RTCIntersectContext& ctx, const ShadowQuery<float>* q, const int* idx,
-                        int n, bool* blocked) {
+void occluded_packet_of(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
+                        const ShadowQuery<float>* q, const int* idx, int n, bool* blocked) {
   alignas(64) RTCRayNt<W> p;
   alignas(64) int valid[W];
   for (int j = 0; j < W; ++j) {
     valid[j] = j < n ? -1 : 0;
     set_lane(p, j, q[idx[j < n ? j : 0]].ray, 1.0f);
+  }
+  if (tiny) {
+    tiny_occluded<W>(k, *tiny, e, ctx, p, n, blocked);
+    return;
   }
   occluded_packet(valid, e.handle(), &ctx, p);
   for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
@@ -97,7 +107,7 @@ void occluded_packet_of(const EmbreeScene& e, RTCIntersectContext& ctx, const Sh
 // (rtcIntersect1 / rtcOccluded1, in trace_path's order), their path steps run together
 // k.lanes wide (shade_x8.h). Every path gets what trace_path would give it, bit for bit.
 PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table,
-                                          RTCIntersectContext& ctx, uint32_t pixel, uint32_t first_sample, int count,
+                                          const TinyScene* tiny, RTCIntersectContext& ctx, uint32_t pixel, uint32_t first_sample, int count,
                                           Local& local) {
   const int width = k.lanes;
   alignas(64) PathState<float> st[kMaxShadeLanes];
@@ -144,8 +154,8 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     // Closest hits (one packet, or one ray at a time); misses end their paths.
     uint32_t hit[kMaxShadeLanes];
     if (kPixelPackets) {
-      if (width == 16) closest_packet<16>(job.embree, ctx, st, live, n_live, hit);
-      else closest_packet<8>(job.embree, ctx, st, live, n_live, hit);
+      if (width == 16) closest_packet<16>(job.embree, k, tiny, ctx, st, live, n_live, hit);
+      else closest_packet<8>(job.embree, k, tiny, ctx, st, live, n_live, hit);
     }
     ShadeBatch batch;
     batch.lanes = 0;
@@ -183,8 +193,8 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     }
     if (n_shadowed > 0) {
       bool blocked[kMaxShadeLanes];
-      if (width == 16) occluded_packet_of<16>(job.embree, ctx, q, shadowed, n_shadowed, blocked);
-      else occluded_packet_of<8>(job.embree, ctx, q, shadowed, n_shadowed, blocked);
+      if (width == 16) occluded_packet_of<16>(job.embree, k, tiny, ctx, q, shadowed, n_shadowed, blocked);
+      else occluded_packet_of<8>(job.embree, k, tiny, ctx, q, shadowed, n_shadowed, blocked);
       for (int j = 0; j < n_shadowed; ++j)
         if (!blocked[j]) shadow_unoccluded(st[shadowed[j]], q[shadowed[j]]);
     }
@@ -199,6 +209,7 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
 template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& job) {
   const std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene, job.isa);
   const BatchKernels* k = table ? batch_kernels(job.isa) : nullptr;
+  const std::unique_ptr<TinyScene> tiny = tiny_scene_for(job.embree, job.scene, k);
   const uint32_t w = job.config.width, h = job.config.height;
   tbb::combinable<Local> locals;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
@@ -211,7 +222,7 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
         if (table) {
           const uint32_t width = uint32_t(k->lanes);
           for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; s += width)
-            trace_samples_batched(job, *k, *table, ctx, pixel, s, int(std::min<uint32_t>(width, end - s)), local);
+            trace_samples_batched(job, *k, *table, tiny.get(), ctx, pixel, s, int(std::min<uint32_t>(width, end - s)), local);
           continue;
         }
         for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; ++s) {

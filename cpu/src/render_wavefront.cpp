@@ -28,6 +28,7 @@
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
 #include "strategies.h"
+#include "tiny_scene.h"
 
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly
@@ -199,9 +200,10 @@ bool rays_to_packet(const BatchKernels* k, const std::vector<Record>& records, c
 
 // With kernels `k` (float, a vector ISA) each packet's rays come by one transpose
 // (rays_to_packet) instead of lane by lane.
+// With `tiny` (and k) the tiny-scene test answers first, Embree only where it is unsure.
 template <int W, class T>
-void stage_intersect(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool, RTCIntersectContext& ctx,
-                     Local& local) {
+void stage_intersect(const TraceJob& job, const BatchKernels* k, const TinyScene* tiny, PoolSlice<T>& pool,
+                     RTCIntersectContext& ctx, Local& local) {
   alignas(64) RTCRayHitNt<W> packet;
   alignas(64) int valid[W];
   init_packet_constants(packet.ray);
@@ -218,6 +220,12 @@ void stage_intersect(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& p
       }
       packet.ray.tfar[i] = kInfinity;
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    if (tiny && filled) {
+      uint32_t prim[W];
+      tiny_closest<W>(*k, *tiny, job.embree, ctx, packet, n, prim);
+      for (int i = 0; i < n; ++i) pool.prim[slots[i]] = prim[i];
+      continue;
     }
     intersect_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i) pool.prim[slots[i]] = packet_triangle(job.embree, packet, i);
@@ -293,7 +301,8 @@ PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const BatchKernels* k, cons
 }
 
 template <int W, class T>
-void stage_shadow(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool, RTCIntersectContext& ctx) {
+void stage_shadow(const TraceJob& job, const BatchKernels* k, const TinyScene* tiny, PoolSlice<T>& pool,
+                  RTCIntersectContext& ctx) {
   alignas(64) RTCRayNt<W> packet;
   alignas(64) int valid[W];
   init_packet_constants(packet);
@@ -305,6 +314,13 @@ void stage_shadow(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool
       valid[i] = i < n ? -1 : 0;
       if (i < n && !filled) set_lane(packet, i, pool.shadow[slots[i]].ray, 1.0f);
       packet.tfar[i] = 1.0f;
+    }
+    if (tiny && filled) {
+      bool blocked[W];
+      tiny_occluded<W>(*k, *tiny, job.embree, ctx, packet, n, blocked);
+      for (int i = 0; i < n; ++i)
+        if (!blocked[i]) shadow_unoccluded(pool.state[slots[i]], pool.shadow[slots[i]]);
+      continue;
     }
     occluded_packet(valid, job.embree.handle(), &ctx, packet);
     for (int i = 0; i < n; ++i) {
@@ -342,6 +358,7 @@ TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const Batch
     throw InputError(fmt::format("--paths-in-flight {}: the path pool would take {:.1f} GB, more than half of this "
                                  "machine's {:.1f} GB of memory; lower it (0 picks a default)",
                                  paths_in_flight, pool_bytes / 1e9, memory / 1e9));
+  const std::unique_ptr<TinyScene> tiny = tiny_scene_for(job.embree, job.scene, k);
   tbb::combinable<Local> locals;
   tbb::parallel_for(0, slices, [&](int) {
     Local& local = locals.local();
@@ -352,9 +369,9 @@ TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const Batch
       stage_generate(job, k, source, pool);
       if (pool.live.empty()) break;
       stage_final_vertex<T, Kinds>(job, k, pool, local);
-      stage_intersect<W>(job, k, pool, ctx, local);
+      stage_intersect<W>(job, k, tiny.get(), pool, ctx, local);
       stage_shade<T, Kinds>(job, k, table.get(), pool, local);
-      stage_shadow<W>(job, k, pool, ctx);
+      stage_shadow<W>(job, k, tiny.get(), pool, ctx);
       stage_accumulate(job, pool, local);
     }
   }, tbb::static_partitioner());

@@ -14,6 +14,8 @@
 
 namespace pb::cpu {
 
+struct TinyScene;  // tiny_scene.h
+
 // The widest batch: AVX-512's 16 float lanes (AVX2: 8). Arrays are sized for it; a
 // kernel reads its own width of them.
 constexpr int kMaxShadeLanes = 16;
@@ -83,6 +85,12 @@ struct BatchKernels {
   void (*rays_to_packet)(const void* const* rows, float* const* org_dir);
   // sincos_turns<float> (sampling.h) of `lanes` turn fractions (for the tests).
   void (*sincos_turns)(const float* u, float* s, float* c);
+  // The tiny-scene test (tiny_x8.h) of `lanes` rays (org_dir: six arrays, as
+  // rays_to_packet fills; tfar: the packet's): closest hit (scene triangle, or
+  // RTC_INVALID_GEOMETRY_ID) or blocked, per lane. Returns the lanes left unsure (bit i:
+  // lane i), whose answer is Embree's to give.
+  uint32_t (*tiny_closest)(const TinyScene&, const float* const* org_dir, const float* tfar, uint32_t* triangle);
+  uint32_t (*tiny_occluded)(const TinyScene&, const float* const* org_dir, const float* tfar, bool* blocked);
 };
 const BatchKernels& avx2_kernels();    // shade_avx2.cpp
 const BatchKernels& avx512_kernels();  // shade_avx512.cpp

@@ -33,6 +33,8 @@ class EmbreeScene {
   // The scene triangle of a hit on Embree primitive `prim` at hit coordinates (u, v).
   uint32_t triangle(uint32_t prim, float u, float v) const { return quads_ ? pairs_.triangle_of(prim, u, v) : prim; }
   uint32_t triangle(const RTCHit& h) const { return triangle(h.primID, h.u, h.v); }
+  // The quads layout's pairing (which vertices Embree sees in which order), else null.
+  const TrianglePairs* pairs() const { return quads_ ? &pairs_ : nullptr; }
   int64_t bytes() const { return bytes_.load(); }
   int64_t peak_bytes() const { return peak_bytes_.load(); }
 

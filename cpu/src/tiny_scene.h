@@ -1,0 +1,127 @@
+#pragma once
+// Tiny scenes ("model only what a scene requires"): for a scene of a few dozen triangles
+// Embree's robust traversal costs ~600 instructions per closest-hit ray (cpu/NOTES.md),
+// while testing every triangle against a packet of rays, lanes = rays, costs a fraction
+// of that. TinyScene is the table such a test reads (the triangles in the vertex order
+// Embree's own Pluecker test sees them, so the arithmetic is Embree's); the test itself
+// is tiny_x8.h (AVX2 / AVX-512, through BatchKernels).
+//
+// The test never guesses. For each ray it either proves Embree's answer -- the hit
+// triangle of a closest-hit query, or whether a shadow ray is blocked -- or it marks the
+// ray "unsure", and the caller asks Embree for that ray (tiny_closest / tiny_occluded
+// below). Unsure: a candidate near an edge of its triangle (inside or out), a hit whose
+// distance is within a small relative margin of another candidate's (ties), of the ray's
+// tfar, or of its origin (the surface the ray leaves from), where Embree's rounding could
+// decide either way. The margins are far above the float error of Embree's formulas and
+// of ours (cpu/NOTES.md gives the bounds), so a proven answer is Embree's answer.
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "embree_rays.h"
+#include "pathbench/common/scene.h"
+#include "pathbench/cpu/embree_scene.h"
+#include "shade_batch.h"
+
+namespace pb::cpu {
+
+struct TinyScene {
+  // Above this many triangles (as Embree sees them) Embree's BVH is cheaper than testing
+  // them all (measured: cpu/NOTES.md).
+  static constexpr size_t kMaxTriangles = 32;
+  struct Triangle {
+    float p[9];         // vertices v0, v1, v2 in Embree's order
+    uint32_t triangle;  // the scene triangle
+    float edge;         // its largest |edge component| (error bounds)
+  };
+  std::vector<Triangle> triangles;
+  float lo[3], hi[3];  // bounds of every vertex
+
+  // The table for the Embree scene `e` of `s`, or null where the scene is too large.
+  // Quads are split as Embree splits them: (v0, v1, v3), then (v2, v3, v1); the empty
+  // second half of a lone triangle's quad (a, b, c, c) is left out (Embree never hits it:
+  // its normal is zero).
+  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s) {
+    auto t = std::make_unique<TinyScene>();
+    auto add = [&](uint32_t a, uint32_t b, uint32_t c, uint32_t tri) {
+      Triangle r;
+      const Vec3f v[3] = {s.positions[a], s.positions[b], s.positions[c]};
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r.p[3 * i + j] = v[i][j];
+      r.triangle = tri;
+      r.edge = 0.0f;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r.edge = std::max(r.edge, std::fabs(v[(i + 1) % 3][j] - v[i][j]));
+      t->triangles.push_back(r);
+    };
+    if (const TrianglePairs* pairs = e.pairs()) {
+      for (size_t q = 0; q < pairs->quads.size(); ++q) {
+        const auto& v = pairs->quads[q];
+        add(v[0], v[1], v[3], pairs->triangle[2 * q]);
+        if (v[2] != v[3]) add(v[2], v[3], v[1], pairs->triangle[2 * q + 1]);
+      }
+    } else {
+      for (uint32_t i = 0; i < s.num_triangles; ++i) add(s.triangles[i].v[0], s.triangles[i].v[1], s.triangles[i].v[2], i);
+    }
+    if (t->triangles.empty() || t->triangles.size() > kMaxTriangles) return nullptr;
+    for (int j = 0; j < 3; ++j) {
+      t->lo[j] = t->hi[j] = t->triangles[0].p[j];
+      for (const Triangle& r : t->triangles)
+        for (int i = 0; i < 3; ++i) {
+          t->lo[j] = std::min(t->lo[j], r.p[3 * i + j]);
+          t->hi[j] = std::max(t->hi[j], r.p[3 * i + j]);
+        }
+    }
+    return t;
+  }
+};
+
+// The tiny test where it applies: batched kernels `k` (a vector ISA; AVX2 needs FMA too,
+// as Embree's AVX2 kernels do) and a scene of at most kMaxTriangles; otherwise null.
+inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const SceneView& s, const BatchKernels* k) {
+  if (!k || !__builtin_cpu_supports("fma")) return nullptr;
+  return TinyScene::build(e, s);
+}
+
+// The closest hits of packet `p` (lanes [0, n) valid; W = k.lanes; tfar already set):
+// the tiny test, and where it leaves any lane unsure, Embree for the whole packet, as
+// the tracer asked before: Embree's own answer for a ray exactly at an edge or at tfar
+// depends on which other lanes are active (packet or single-ray traversal, whose
+// formulas round differently), so only the same call gives the same answer. prim[i]: the
+// scene triangle, or RTC_INVALID_GEOMETRY_ID. Returns the number of unsure lanes.
+template <int W>
+int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e, RTCIntersectContext& ctx,
+                 RTCRayHitNt<W>& p, int n, uint32_t* prim) {
+  const float* const rays[6] = {p.ray.org_x, p.ray.org_y, p.ray.org_z, p.ray.dir_x, p.ray.dir_y, p.ray.dir_z};
+  uint32_t unsure = k.tiny_closest(t, rays, p.ray.tfar, prim) & uint32_t((uint64_t(1) << n) - 1);
+  if (unsure == 0) return 0;
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  intersect_packet(valid, e.handle(), &ctx, p);
+  for (int i = 0; i < n; ++i)
+    if ((unsure >> i) & 1) prim[i] = packet_triangle(e, p, i);
+  return __builtin_popcount(unsure);
+}
+
+// Whether each shadow ray of packet `p` (lanes [0, n), tfar set) is blocked: the tiny
+// test, then (as tiny_closest) Embree for the whole packet where it left a lane unsure.
+// Returns the number of unsure lanes.
+template <int W>
+int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e, RTCIntersectContext& ctx,
+                  RTCRayNt<W>& p, int n, bool* blocked) {
+  const float* const rays[6] = {p.org_x, p.org_y, p.org_z, p.dir_x, p.dir_y, p.dir_z};
+  uint32_t unsure = k.tiny_occluded(t, rays, p.tfar, blocked) & uint32_t((uint64_t(1) << n) - 1);
+  if (unsure == 0) return 0;
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  occluded_packet(valid, e.handle(), &ctx, p);
+  for (int i = 0; i < n; ++i)
+    if ((unsure >> i) & 1) blocked[i] = p.tfar[i] < 0.0f;
+  return __builtin_popcount(unsure);
+}
+
+}  // namespace pb::cpu

@@ -1,0 +1,132 @@
+// (No include guard: included once per instruction set by shade_kernels.inc, after
+// simd8.h, under a target that adds FMA.) The tiny-scene test (tiny_scene.h): kLanes rays
+// against every triangle of a TinyScene, lanes = rays.
+//
+// Per triangle it evaluates Embree 3's robust Pluecker test in Embree's order of
+// operations (vertices relative to the ray origin, edge functions U, V, W as
+// dot(cross(e, v + v'), D) with FMA, den and T doubled; the normal as cross(e0, e1)),
+// then decides with margins instead of Embree's exact comparisons:
+//   inside  all of U, V, W beyond +-m with one sign     outside  some beyond +m, some beyond -m
+//   front   T (sign of den applied) > band               behind   < -band
+//   before  t < tfar (1 - 2^-20) - err                    beyond   t > tfar (1 + 2^-20) + err
+// A candidate that is inside, front and before is a proven hit: Embree's test accepts it
+// too. One that is outside, behind or beyond is proven irrelevant. Anything else (near an
+// edge, near the origin's own surface, near tfar) is a doubt at distance t (0 when the
+// depth is in doubt). A ray is unsure when a doubt or a second proven hit lies within a
+// relative 2^-14 of its nearest proven hit (or it has doubts and no proven hit): Embree
+// decides those (tiny_scene.h). m and band scale with the worst-case size of the terms:
+// Both computations start from the same rounded vertices (v = p - o, e = v - v', v + v'
+// are single IEEE operations in either), so they differ only in how the products are
+// rounded: m = 2^-16 E M |D|_1 (E: this triangle's largest edge component, M: a bound on
+// |vertex - origin| over the scene), band = 2^-20 |v0|_inf (|Ng|_1 + 3 E^2), t's error
+// band / |den| + 2^-20 t.
+// cpu/NOTES.md derives them.
+namespace pb::cpu::PB_SIMD_NS {
+
+#if PB_SIMD_LANES == 16
+inline FV fmadd(FV a, FV b, FV c) { return FV(_mm512_fmadd_ps(__m512(a), __m512(b), __m512(c))); }
+inline FV fmsub(FV a, FV b, FV c) { return FV(_mm512_fmsub_ps(__m512(a), __m512(b), __m512(c))); }
+inline uint32_t lane_mask(IV m) { return uint32_t(_mm512_movepi32_mask(__m512i(m))); }
+#else
+inline FV fmadd(FV a, FV b, FV c) { return FV(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c))); }
+inline FV fmsub(FV a, FV b, FV c) { return FV(_mm256_fmsub_ps(__m256(a), __m256(b), __m256(c))); }
+inline uint32_t lane_mask(IV m) { return uint32_t(_mm256_movemask_ps(__m256(m))); }
+#endif
+
+// Embree's Vec3 dot and cross (common/math/vec3.h): madd / msub are single FMAs.
+inline FV emb_dot(V3 a, V3 b) { return fmadd(a.x, b.x, fmadd(a.y, b.y, a.z * b.z)); }
+inline V3 emb_cross(V3 a, V3 b) {
+  return {fmsub(a.y, b.z, a.z * b.y), fmsub(a.z, b.x, a.x * b.z), fmsub(a.x, b.y, a.y * b.x)};
+}
+struct TinyResult {
+  FV best, best_lo, best_hi;  // nearest proven hit's distance and its error interval
+  FV other_lo;       // lowest bottom of any other proven hit's or doubt's interval
+  UV id;             // scene triangle of `best`
+};
+
+// Every triangle of `s` against the rays; `any_hit` (occlusion): only whether a proven
+// hit exists, and stop once every lane has one.
+inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in, bool any_hit) {
+  FV c[6], tfar;
+  for (int j = 0; j < 6; ++j) std::memcpy(&c[j], rays[j], sizeof(FV));
+  std::memcpy(&tfar, tfar_in, sizeof tfar);
+  const V3 o{c[0], c[1], c[2]}, d{c[3], c[4], c[5]};
+  const FV oc[3] = {o.x, o.y, o.z};
+  FV m_bound = splat(0.0f);
+  for (int j = 0; j < 3; ++j) m_bound = vmax(m_bound, vmax(abs(s.hi[j] - oc[j]), abs(oc[j] - s.lo[j])));
+  m_bound = m_bound * (1.0f + 0x1p-20f);  // the rounding of vertex - origin
+  const FV d1 = abs(d.x) + abs(d.y) + abs(d.z);
+  const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
+  const FV inf = splat(__builtin_inff());
+  const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
+  TinyResult r{inf, inf, inf, inf, UV{} + RTC_INVALID_GEOMETRY_ID};
+  for (const TinyScene::Triangle& tr : s.triangles) {
+    const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
+    const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
+    const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
+    const V3 e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
+    const FV U = emb_dot(emb_cross(e0, v2 + v0), d);
+    const FV V = emb_dot(emb_cross(e1, v0 + v1), d);
+    const FV W = emb_dot(emb_cross(e2, v1 + v2), d);
+    const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
+    const FV m = m_scale * tr.edge;
+    const IV outside = (hi > m) & (lo < -m);
+    if (lane_mask(~outside) == 0) continue;  // (movemask: any() tests lane by lane)
+    // cross(e0, e1): Embree's stable_triangle_normal picks, per component, between it
+    // and cross(e1, e2), equal but for rounding (|difference| << E^2, inside `band`).
+    const V3 ng = emb_cross(e0, e1);
+    FV den = emb_dot(ng, d);
+    den = den + den;
+    FV T = emb_dot(v0, ng);
+    T = T + T;
+    const FV abs_den = abs(den);
+    const FV Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
+    const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
+    // T = 2 dot(v0, Ng): the two computations' Ng differ by rounding relative to E^2, and
+    // the dot by rounding relative to |v0| |Ng|.
+    const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
+    const FV band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
+    const IV grazing = abs_den <= 0x1p-15f * ng1 * d1;        // |den| <= 2 |Ng|_1 |D|_1: 2^-16 of that
+    const IV inside = ((lo > m) | (hi < -m)) & ~grazing;
+    const IV front = Ts > band, behind = Ts < -band;
+    const IV before = Ts < abs_den * tfar_lo - band, beyond = Ts > abs_den * tfar_hi + band;
+    const IV proven = inside & front & before;
+    // den == 0: Embree rejects the triangle outright (a ray in its plane).
+    const IV doubt = ~proven & ~outside & (abs_den != 0.0f) & (grazing | ~(behind | beyond));
+    const FV rcp = 1.0f / abs_den;
+    const FV t = Ts * rcp, err = band * rcp + 0x1p-20f * abs(t);
+    if (any_hit) {
+      r.best = select(proven, t, r.best);
+      r.other_lo = select(doubt, splat(0.0f), r.other_lo);
+      if (lane_mask(r.best == inf) == 0) break;  // every ray blocked: doubts no longer matter
+      continue;
+    }
+    // A doubt's distance counts only where it is known (in front, not grazing); else 0.
+    const FV doubt_lo = select(front & ~grazing, t - err, splat(0.0f));
+    const IV nearer = proven & (t < r.best);
+    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best_lo, t - err)), r.other_lo);
+    r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
+    r.best = select(nearer, t, r.best);
+    r.best_lo = select(nearer, t - err, r.best_lo);
+    r.best_hi = select(nearer, t + err, r.best_hi);
+    r.id = nearer ? UV{} + tr.triangle : r.id;
+  }
+  return r;
+}
+
+inline uint32_t tiny_closest(const TinyScene& s, const float* const* rays, const float* tfar, uint32_t* triangle) {
+  const TinyResult r = tiny_test(s, rays, tfar, false);
+  const IV unsure = (r.other_lo < splat(__builtin_inff())) & (r.other_lo <= r.best_hi);
+  std::memcpy(triangle, &r.id, sizeof r.id);
+  return lane_mask(unsure);
+}
+
+inline uint32_t tiny_occluded(const TinyScene& s, const float* const* rays, const float* tfar, bool* blocked) {
+  const TinyResult r = tiny_test(s, rays, tfar, true);
+  const FV inf = splat(__builtin_inff());
+  const IV hit = r.best < inf;
+  for (int i = 0; i < kLanes; ++i) blocked[i] = hit[i] != 0;
+  return lane_mask(~hit & (r.other_lo < inf));
+}
+
+}  // namespace pb::cpu::PB_SIMD_NS
