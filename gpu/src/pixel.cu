@@ -8,7 +8,7 @@
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"
 #include "strategies.cuh"
 
 namespace pb::gpu {

@@ -9,7 +9,7 @@
 #include "device_film.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"
 #include "wavefront_state.cuh"
 
 namespace pb::gpu {

@@ -44,8 +44,9 @@ struct alignas(16) BvhTriangle {
 };
 static_assert(sizeof(BvhTriangle) == 48, "BvhTriangle is 48 bytes");
 
-// What the traversal reads: host or device pointers.
-struct BvhView {
+// What the binary traversal reads: host or device pointers. (The kernels get a BvhView,
+// traversal.h: the scene's BVH in whichever layout it was built.)
+struct BinaryBvhView {
   const BvhNode* nodes;      // node 0 is the root, always an inner node
   const BvhTriangle* tris;
   uint32_t num_nodes;
@@ -111,13 +112,13 @@ PB_HD float safe_inverse(float d) {
 // The closest hit's answer. Woop's t ordered the candidates; the winner's t comes from
 // the plane equation in double (watertight.h), accurate on grazing rays too.
 template <bool kWatertight>
-PB_HD uint32_t finish_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, uint32_t hit,
+PB_HD uint32_t finish_closest(const BvhTriangle* tris, const Vec3f& o, const Vec3f& d, float t_max, uint32_t hit,
                               uint32_t slot, float t, float& t_hit) {
   t_hit = t;
   if (kWatertight && hit != kNoHit) {
     Vec3f a, b, c;
     uint32_t prim;
-    load_triangle(bvh.tris, slot, a, b, c, prim);
+    load_triangle(tris, slot, a, b, c, prim);
     const float exact = plane_distance(o, d, a, b, c);
     if (exact > 0.0f && exact < t_max) t_hit = exact;
   }
@@ -131,7 +132,7 @@ PB_HD uint32_t finish_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d
 // t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
 // Moeller-Trumbore (the paper's; the accuracy study's comparison).
 template <bool kAnyHit, bool kWatertight = true>
-PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
+PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
   const WatertightRay wr = make_watertight_ray(o, d);
   const Vec3f inv = {detail::safe_inverse(d.x), detail::safe_inverse(d.y), detail::safe_inverse(d.z)};
@@ -167,7 +168,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       } else if (h0 || h1) {
         ref = h0 ? child[0] : child[1];
       } else {
-        if (sp == 0) return detail::finish_closest<kWatertight>(bvh, o, d, t_max, hit, hit_slot, t, t_hit);
+        if (sp == 0) return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
         ref = stack[--sp];
       }
     }
@@ -191,15 +192,15 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
     if (sp == 0) break;
     ref = stack[--sp];
   }
-  return detail::finish_closest<kWatertight>(bvh, o, d, t_max, hit, hit_slot, t, t_hit);
+  return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
 template <bool kWatertight = true>
-PB_HD uint32_t intersect_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
+PB_HD uint32_t intersect_closest(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
   return traverse<false, kWatertight>(bvh, o, d, t_max, t_hit);
 }
 template <bool kWatertight = true>
-PB_HD bool occluded(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
+PB_HD bool occluded(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
   float t;
   return traverse<true, kWatertight>(bvh, o, d, t_max, t) != kNoHit;
 }

@@ -35,10 +35,15 @@ struct DeviceInfo {
 // Throws InputError when there is no device.
 DeviceInfo device_info();
 
+struct GpuBvhOptions;  // bvh_layout.h
+
 // The scene on the device: arrays and BVH, uploaded once, reusable for many renders.
+// The BVH's layout comes from `options` (binary, wide4, wide8, brute force; bvh_layout.h),
+// or from the environment (GpuBvhOptions::from_env: PATHBENCH_GPU_BVH, ...).
 class GpuScene {
  public:
   explicit GpuScene(const Scene& scene);
+  GpuScene(const Scene& scene, const GpuBvhOptions& options);
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
