@@ -30,8 +30,13 @@ __global__ void k_trace(BvhView bvh, const TraceQuery* rays, TraceResult* out, u
 }  // namespace
 
 std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit) {
+  return trace_on_device(scene, rays, any_hit, GpuBvhOptions::from_env());
+}
+
+std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit,
+                                         const GpuBvhOptions& options) {
   ensure_device();
-  const GpuScene gs(scene);
+  const GpuScene gs(scene, options);
   DeviceBuffer<TraceQuery> d_rays(rays.size(), "test rays", "the number of rays");
   DeviceBuffer<TraceResult> d_out(rays.size(), "test results", "the number of rays");
   d_rays.upload(rays.data(), rays.size());

@@ -7,6 +7,7 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
 
 namespace pb::gpu {
 

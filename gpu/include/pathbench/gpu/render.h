@@ -78,6 +78,8 @@ struct TraceResult {
   float t;
 };
 std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit);
+std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit,
+                                         const GpuBvhOptions& options);
 
 // Ray casting alone, for the raw ray-cast benchmarks: the rays are uploaded once, the
 // traversal kernel runs once to warm up, then `repeats` launches are each timed with

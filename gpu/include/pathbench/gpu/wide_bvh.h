@@ -18,6 +18,14 @@
 #include "pathbench/common/math.h"
 #include "pathbench/gpu/bvh.h"
 
+// The per-node loops must unroll on the device: their small arrays then live in
+// registers, not in local memory.
+#if defined(__CUDA_ARCH__)
+#define PB_WIDE_UNROLL _Pragma("unroll")
+#else
+#define PB_WIDE_UNROLL
+#endif
+
 namespace pb::gpu {
 
 constexpr uint32_t kWideMaxChildren = 8;
@@ -86,6 +94,7 @@ PB_HD float exp2_of_byte(uint32_t e) {  // 2^(e - 127) for e in 1..254: a normal
 PB_HD void load_wide_node(const WideNode* nodes, uint32_t i, uint32_t (&w)[20]) {
 #if defined(__CUDA_ARCH__)
   const uint4* p = reinterpret_cast<const uint4*>(nodes + i);
+  PB_WIDE_UNROLL
   for (int k = 0; k < 5; ++k) {
     const uint4 v = __ldg(p + k);
     w[4 * k] = v.x; w[4 * k + 1] = v.y; w[4 * k + 2] = v.z; w[4 * k + 3] = v.w;
@@ -152,19 +161,23 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       const uint32_t e_imask = w[3];
       const uint32_t imask = e_imask >> 24;
       float a[3], b[3];
+      PB_WIDE_UNROLL
       for (int k = 0; k < 3; ++k) {
         a[k] = detail::exp2_of_byte((e_imask >> (8 * k)) & 0xFFu) * inv_a[k];
         b[k] = detail::fmadd(detail::word_as_float(w[k]), inv_a[k], oi_a[k]);
       }
       uint32_t hitmask = 0;
+      PB_WIDE_UNROLL
       for (int half = 0; half < 2; ++half) {  // slots 4 * half .. 4 * half + 3
         const uint32_t meta4 = w[6 + half];
         uint32_t qn[3], qf[3];
+        PB_WIDE_UNROLL
         for (int k = 0; k < 3; ++k) {
           const uint32_t lo = w[8 + 2 * k + half], hi = w[14 + 2 * k + half];
           qn[k] = neg[k] ? hi : lo;
           qf[k] = neg[k] ? lo : hi;
         }
+        PB_WIDE_UNROLL
         for (int j = 0; j < 4; ++j) {
           const uint32_t meta = (meta4 >> (8 * j)) & 0xFFu;
           const float tx0 = detail::fmadd(detail::byte_as_float(qn[0], j), a[0], b[0]);
