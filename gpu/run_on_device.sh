@@ -110,6 +110,11 @@ if has ico; then
   timeout 60 $PB render --device gpu --quiet $ico --strategy pixel --profile | tee -a "$OUT/summary.txt"
 fi
 
+# Seconds since the script began: the layouts phase leaves out its last, optional
+# pieces (sanitizers, per-layout ctest) past LAYOUTS_BUDGET_S, so that the results are
+# packed before a device call's time limit.
+in_budget() { [ "$SECONDS" -lt "${LAYOUTS_BUDGET_S:-500}" ] || { log "skipped (past ${LAYOUTS_BUDGET_S:-500} s): $*"; return 1; }; }
+
 if has layouts; then
   layouts=${LAYOUTS:-binary wide4 wide8 brute}
   ico="--scene paper-cornell-ico:8 --width 256 --height 256 --spp 800 --bounces 2 --sampling nee"
@@ -130,6 +135,23 @@ if has layouts; then
     timeout 60 $PB render --device gpu --quiet $paper --strategy pixel --profile > "$OUT/logs/layout-profile-$l.txt" 2>&1
   done
   unset PATHBENCH_GPU_BVH
+  log "render medians per layout (device ms)"
+  python3 - "$OUT/json" <<'PY' | tee -a "$OUT/summary.txt"
+import glob, json, os, re, statistics, sys
+runs = {}
+for f in glob.glob(os.path.join(sys.argv[1], "layout-*.json")):
+    m = re.match(r"layout-(paper|ico)-(pixel|wavefront)-(\w+?)(?:-\d+)?\.json$", os.path.basename(f))
+    if not m:
+        continue
+    try:
+        j = json.load(open(f))
+    except Exception:
+        continue
+    runs.setdefault(m.groups(), []).append(j["device_seconds"] * 1e3)
+for key in sorted(runs):
+    v = runs[key]
+    print(f"{key[0]:6s} {key[1]:10s} {key[2]:7s} median {statistics.median(v):8.2f} ms  (n={len(v)}: {', '.join(f'{x:.2f}' for x in v)})")
+PY
   log "raw ray casts per layout (pathbench-bench --preset gpu-layouts)"
   timeout 300 $B/bin/pathbench-bench --preset gpu-layouts --benchmark_out="$OUT/json/bench-gpu-layouts.json" \
     --benchmark_out_format=json > "$OUT/logs/bench-gpu-layouts.txt" 2>&1
@@ -146,9 +168,19 @@ for r in rows:
     else:
         print(f"{r['name']:64s} {r.get('error_message', 'no rate')}")
 PY
+  log "GPU tests in each layout (ctest -L gpu)"
+  for l in ${CTEST_LAYOUTS:-wide8 brute binary wide4}; do
+    in_budget "ctest -L gpu in layout $l" || continue
+    export PATHBENCH_GPU_BVH=$l
+    (cd $B && ctest -L gpu --output-on-failure -V --timeout 300) > "$OUT/logs/ctest-gpu-$l.txt" 2>&1
+    log "ctest -L gpu, PATHBENCH_GPU_BVH=$l rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-gpu-$l.txt)"
+    grep -E "FAILED|Failure" "$OUT/logs/ctest-gpu-$l.txt" | sed 's/^[0-9]*: //' | sort -u | head -20 | tee -a "$OUT/summary.txt"
+  done
+  unset PATHBENCH_GPU_BVH
   log "compute-sanitizer in each layout (paper-cornell-ico:2, 32x32x4)"
   small_ico="--scene paper-cornell-ico:2 --width 32 --height 32 --spp 4 --bounces 2 --sampling nee --device gpu --quiet"
   for l in $layouts; do
+    in_budget "sanitizers in layout $l" || continue
     export PATHBENCH_GPU_BVH=$l
     for tool in memcheck racecheck; do
       for st in pixel wavefront; do
@@ -157,14 +189,6 @@ PY
         echo "$l $tool $st: rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' $OUT/logs/sanitizer-$tool-$st-$l.txt)" | tee -a "$OUT/summary.txt"
       done
     done
-  done
-  unset PATHBENCH_GPU_BVH
-  log "GPU tests in each layout (ctest -L gpu)"
-  for l in $layouts; do
-    export PATHBENCH_GPU_BVH=$l
-    (cd $B && ctest -L gpu --output-on-failure -V --timeout 300) > "$OUT/logs/ctest-gpu-$l.txt" 2>&1
-    log "ctest -L gpu, PATHBENCH_GPU_BVH=$l rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-gpu-$l.txt)"
-    grep -E "FAILED|Failure" "$OUT/logs/ctest-gpu-$l.txt" | sed 's/^[0-9]*: //' | sort -u | head -20 | tee -a "$OUT/summary.txt"
   done
   unset PATHBENCH_GPU_BVH
 fi

@@ -51,13 +51,14 @@ __global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig 
   }
 }
 
+template <int kKind>  // the BVH layout (traversal.h)
 __global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
   kernel_prologue();
   const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const float4 o = cur.o[i], d = cur.d[i];
     float t;
-    prim[i] = intersect_closest(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
+    prim[i] = intersect_closest<true, kKind>(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
   }
 }
 
@@ -125,7 +126,7 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
   }
 }
 
-template <bool kVariance>
+template <bool kVariance, int kKind>
 __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
                                                       FilmDev film) {
   kernel_prologue();
@@ -141,7 +142,7 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
       const float2 ct = sh.ct[i];
       const uint32_t target = __float_as_uint(ct.y);
       const Vec3f origin{o.x, o.y, o.z};
-      const bool visible = !occluded(bvh, origin, {d.x, d.y, d.z}, 1.0f);
+      const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
       if (target & kShadowDone) {
         const float4 l = sh.L[i];
         L = {l.x, l.y, l.z};
@@ -149,7 +150,7 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
         if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
           const float4 d2 = sh.d2[i];
           const float2 c2 = sh.c2[i];
-          if (!occluded(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
+          if (!occluded<true, kKind>(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
         }
         add = true;
         pixel = target & ~kShadowDone;

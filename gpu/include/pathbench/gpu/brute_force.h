@@ -21,19 +21,9 @@ PB_HD uint32_t traverse_all(const BvhTriangle* tris, uint32_t n, const Vec3f& o,
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   for (uint32_t i = 0; i < n; ++i) {
-    Vec3f a, b, c;
-    uint32_t prim;
-    detail::load_triangle(tris, i, a, b, c, prim);
-    if (stats) ++stats->tris;
-    float tt;
-    bool h;
-    if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
-    else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
-    if (h) {
-      t = tt;
-      hit = prim;
-      hit_slot = i;
-      if (kAnyHit) { t_hit = t; return hit; }
+    if (detail::test_triangle<kWatertight>(tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+      t_hit = t;
+      return hit;
     }
   }
   return detail::finish_closest<kWatertight>(tris, o, d, t_max, hit, hit_slot, t, t_hit);

@@ -109,6 +109,27 @@ PB_HD float safe_inverse(float d) {
   return 1.0f / (std::fabs(d) > kTiny ? d : (d >= 0.0f ? kTiny : -kTiny));
 }
 
+// Tests triangle slot i of `tris` for a hit closer than t; on a hit narrows t to it and
+// records the triangle (scene id and slot). Every traversal's leaf test.
+template <bool kWatertight>
+PB_HD bool test_triangle(const BvhTriangle* tris, uint32_t i, const WatertightRay& wr, const Vec3f& o, const Vec3f& d,
+                         float& t, uint32_t& hit, uint32_t& hit_slot, TraversalStats* stats) {
+  Vec3f a, b, c;
+  uint32_t prim;
+  load_triangle(tris, i, a, b, c, prim);
+  if (stats) ++stats->tris;
+  float tt;
+  bool h;
+  if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
+  else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
+  if (h) {
+    t = tt;
+    hit = prim;
+    hit_slot = i;
+  }
+  return h;
+}
+
 // The closest hit's answer. Woop's t ordered the candidates; the winner's t comes from
 // the plane equation in double (watertight.h), accurate on grazing rays too.
 template <bool kWatertight>
@@ -174,19 +195,9 @@ PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d
     }
     const uint32_t first = leaf_first(ref), count = leaf_count(ref);
     for (uint32_t i = first; i < first + count; ++i) {
-      Vec3f a, b, c;
-      uint32_t prim;
-      detail::load_triangle(bvh.tris, i, a, b, c, prim);
-      if (stats) ++stats->tris;
-      float tt;
-      bool h;
-      if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
-      else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
-      if (h) {
-        t = tt;
-        hit = prim;
-        hit_slot = i;
-        if (kAnyHit) { t_hit = t; return hit; }
+      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+        t_hit = t;
+        return hit;
       }
     }
     if (sp == 0) break;

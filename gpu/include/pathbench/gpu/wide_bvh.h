@@ -204,19 +204,9 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       const uint32_t k = detail::lowest_bit(thits);
       thits &= thits - 1u;
       const uint32_t i = tbase + k;
-      Vec3f a, b, c;
-      uint32_t prim;
-      detail::load_triangle(bvh.tris, i, a, b, c, prim);
-      if (stats) ++stats->tris;
-      float tt;
-      bool h;
-      if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
-      else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
-      if (h) {
-        t = tt;
-        hit = prim;
-        hit_slot = i;
-        if (kAnyHit) { t_hit = t; return hit; }
+      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+        t_hit = t;
+        return hit;
       }
     }
     if (!(ng.hits & 0xFF000000u)) {
