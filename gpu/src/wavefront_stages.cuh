@@ -51,8 +51,14 @@ __global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig 
   }
 }
 
+// Blocks an SM for the traversal stages: 5 (48 registers) suits the binary and brute-force
+// traversals; the wide one holds a node's 20 words and spills under 48 (ptxas: 28 B in
+// intersect, 100 B in shadow), so it gets 4 (64 registers).
+template <int kKind>
+constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
+
 template <int kKind>  // the BVH layout (traversal.h)
-__global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
   kernel_prologue();
   const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
@@ -127,7 +133,7 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
 }
 
 template <bool kVariance, int kKind>
-__global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
+__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
                                                       FilmDev film) {
   kernel_prologue();
   const uint32_t n = ctr->n_shadow;
