@@ -10,6 +10,9 @@
 //   scaling  rays/s vs triangle count (scaling:N, N = 10 .. 10^7), time vs spp and
 //            vs resolution (paper-cornell); Embree ray casts on every scaling:N.
 //   materials  diffuse-only against mirror/glass/GGX scenes (materials_bench.h).
+//   gpu-layouts  the GPU BVH layouts side by side (bvh_layout.h): raw ray casts in each
+//            layout on paper-cornell, paper-cornell-ico:0/1/2 (34, 94, 334 triangles:
+//            where brute force stops paying) and paper-cornell-ico:8 (1.31 M).
 //
 // Regression runs: --benchmark_repetitions=9 --benchmark_report_aggregates_only=false
 // --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`. That file is
@@ -18,6 +21,7 @@
 #include <benchmark/benchmark.h>
 #include <fmt/core.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <sstream>
@@ -25,6 +29,9 @@
 #include <vector>
 
 #include "bench_context.h"
+#if PATHBENCH_BENCH_GPU
+#include "pathbench/gpu/bvh_layout.h"
+#endif
 #include "materials_bench.h"
 #include "raycast_bench.h"
 #include "render_bench.h"
@@ -109,6 +116,19 @@ void preset_scaling() {
     }
 }
 
+void preset_gpu_layouts() {
+#if PATHBENCH_BENCH_GPU
+  using gpu::GpuBvhLayout;
+  for (const char* scene : {"paper-cornell", "paper-cornell-ico:0", "paper-cornell-ico:1", "paper-cornell-ico:2",
+                            "paper-cornell-ico:8"})
+    register_gpu_raycast_benchmarks({scene, 256, 256}, {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,
+                                                        GpuBvhLayout::Brute});
+#else
+  fmt::print(stderr, "pathbench-bench: --preset gpu-layouts needs a CUDA build (PATHBENCH_CUDA=ON)\n");
+  std::exit(2);
+#endif
+}
+
 }  // namespace
 }  // namespace pb::bench
 
@@ -135,8 +155,10 @@ int main(int argc, char** argv) {
   else if (preset == "paper") pb::bench::preset_paper();
   else if (preset == "scaling") pb::bench::preset_scaling();
   else if (preset == "materials") pb::bench::preset_materials();
+  else if (preset == "gpu-layouts") pb::bench::preset_gpu_layouts();
   else {
-    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling or materials)\n", preset);
+    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling, materials or gpu-layouts)\n",
+               preset);
     return 2;
   }
   // The output file (--benchmark_out=PATH, JSON unless another format is asked for) is

@@ -27,6 +27,9 @@
 namespace pb::cpu {
 class EmbreeScene;
 }
+namespace pb::gpu {
+enum class GpuBvhLayout : uint32_t;
+}
 
 namespace pb::bench {
 
@@ -48,7 +51,10 @@ struct RaycastCase {
 };
 // Registers every api x {coherent, incoherent} for one scene.
 void register_raycast_benchmarks(const RaycastCase& c);
-// The GPU BVH's: raycast/gpu/<closest|any>/<coherent|incoherent>/<scene> (CUDA builds).
+// The GPU BVH's: raycast/gpu/<closest|any>/<coherent|incoherent>/<scene> (CUDA builds),
+// in the default layout; with `layouts`, one row set per layout, named .../<scene>/<layout>
+// (gpu::GpuBvhLayout, bvh_layout.h; Auto: the default rows), all in one process.
 void register_gpu_raycast_benchmarks(const RaycastCase& c);
+void register_gpu_raycast_benchmarks(const RaycastCase& c, const std::vector<gpu::GpuBvhLayout>& layouts);
 
 }  // namespace pb::bench

@@ -1,6 +1,8 @@
 // Raw ray casts through the GPU BVH (no shading): the GPU tracers' ceiling, beside the
 // Embree ones of raycast_bench.cpp and on the same stored rays.
-//   raycast/gpu/<closest|any>/<coherent|incoherent>/<scene>
+//   raycast/gpu/<closest|any>/<coherent|incoherent>/<scene>           (the default layout)
+//   raycast/gpu/<closest|any>/<coherent|incoherent>/<scene>/<layout>  (binary, wide4, wide8,
+//                                                                     brute: bvh_layout.h)
 // Each iteration is one launch of the traversal kernel over every ray (the stored rays
 // repeated to at least 4 M), timed with CUDA events after a warm-up launch
 // (UseManualTime).
@@ -11,6 +13,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/cpu/embree_scene.h"
+#include "pathbench/gpu/bvh_layout.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "raycast_bench.h"
@@ -40,22 +43,35 @@ std::vector<gpu::TraceQuery> to_queries(const RaySet& s, bool any_hit) {
   return q;
 }
 
-void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit, bool coherent) {
+// Brute force tests every triangle for every ray: past this many it only burns time.
+constexpr size_t kBruteBenchMaxTriangles = 4096;
+
+// `layout` Auto: the options from the environment (what renders use).
+void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit, bool coherent,
+                     gpu::GpuBvhLayout layout) {
   std::string why;
   if (!run::gpu_available(&why)) {
     state.SkipWithError(("no GPU: " + why).c_str());
     return;
   }
   std::shared_ptr<GpuPrepared> prep;
-  const std::string kind = fmt::format("gpu-raycast:{}x{}:{}", c.width, c.height, any_hit ? "any" : "closest");
+  const std::string kind = fmt::format("gpu-raycast:{}x{}:{}:{}", c.width, c.height, any_hit ? "any" : "closest",
+                                       gpu::to_string(layout));
   try {
     prep = std::static_pointer_cast<GpuPrepared>(cached_extra(c.scene, kind));
     if (!prep) {
       std::shared_ptr<const Scene> scene = cached_scene(c.scene);
+      if (layout == gpu::GpuBvhLayout::Brute && scene->triangles.size() > kBruteBenchMaxTriangles) {
+        state.SkipWithError(fmt::format("brute force on {} triangles: over {}", scene->triangles.size(),
+                                        kBruteBenchMaxTriangles).c_str());
+        return;
+      }
       const RaySets rays = make_ray_sets(*scene, *cpu::make_embree_scene(*scene, RenderSettings{}.watertight), c.width,
                                          c.height);
       prep = std::make_shared<GpuPrepared>();
-      prep->scene = std::make_unique<gpu::GpuScene>(*scene);
+      gpu::GpuBvhOptions options = gpu::GpuBvhOptions::from_env();
+      if (layout != gpu::GpuBvhLayout::Auto) options.layout = layout;
+      prep->scene = std::make_unique<gpu::GpuScene>(*scene, options);
       prep->coherent = to_queries(rays.coherent, any_hit);
       prep->incoherent = to_queries(rays.incoherent, any_hit);
       store_extra(c.scene, kind, prep);
@@ -85,15 +101,19 @@ void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit
 
 }  // namespace
 
-void register_gpu_raycast_benchmarks(const RaycastCase& c) {
-  for (bool any_hit : {false, true})
-    for (bool coherent : {true, false}) {
-      const std::string name = fmt::format("raycast/gpu/{}/{}/{}", any_hit ? "any" : "closest",
-                                           coherent ? "coherent" : "incoherent", c.scene);
-      benchmark::RegisterBenchmark(name.c_str(), [c, any_hit, coherent](benchmark::State& st) {
-        run_gpu_raycast(st, c, any_hit, coherent);
-      })->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(20);  // each re-uploads the rays (untimed)
-    }
+void register_gpu_raycast_benchmarks(const RaycastCase& c) { register_gpu_raycast_benchmarks(c, {gpu::GpuBvhLayout::Auto}); }
+
+void register_gpu_raycast_benchmarks(const RaycastCase& c, const std::vector<gpu::GpuBvhLayout>& layouts) {
+  for (gpu::GpuBvhLayout layout : layouts)
+    for (bool any_hit : {false, true})
+      for (bool coherent : {true, false}) {
+        std::string name = fmt::format("raycast/gpu/{}/{}/{}", any_hit ? "any" : "closest",
+                                       coherent ? "coherent" : "incoherent", c.scene);
+        if (layout != gpu::GpuBvhLayout::Auto) name += std::string("/") + gpu::to_string(layout);
+        benchmark::RegisterBenchmark(name.c_str(), [c, any_hit, coherent, layout](benchmark::State& st) {
+          run_gpu_raycast(st, c, any_hit, coherent, layout);
+        })->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(20);  // each re-uploads the rays (untimed)
+      }
 }
 
 }  // namespace pb::bench

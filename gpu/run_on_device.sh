@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Builds, tests, sanitizes and benchmarks the GPU tracer on a GPU host (the device
 # machine), writing everything under $OUT (default: ./device-out). Phases are chosen
-# by arguments: build test sanitize bench ico accuracy (default: all).
+# by arguments: build test sanitize bench ico accuracy layouts (default: all but layouts).
+#   layouts: the GPU BVH layouts (PATHBENCH_GPU_BVH: binary, wide4, wide8, brute)
+#   side by side, interleaved: paper-cornell and ico:8 renders, raw ray casts
+#   (pathbench-bench --preset gpu-layouts), and the GPU tests in each layout.
 #   source .gpu-deps/unpack.sh is done here; see ../shared/gpu-host/README.md.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -12,7 +15,7 @@ pack() {
   rm -rf "$OUT/logs" "$OUT/json" "$OUT/accuracy"
 }
 trap pack EXIT
-phases=${*:-build test sanitize bench ico accuracy}
+phases=${*:-build test sanitize bench ico accuracy}  # layouts: only when asked for
 has() { [[ " $phases " == *" $1 "* ]]; }
 log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
 B=build-gpu
@@ -60,7 +63,8 @@ try:
     j = json.load(open(path))
 except Exception:
     print(f"{name}: rc={rc} (no report)"); sys.exit()
-print(f"{name}: rc={rc} device {j['device_seconds']*1e3:.2f} ms, wall {j['seconds']*1e3:.1f} ms, "
+bvh = j.get('bvh', {})
+print(f"{name}: rc={rc} bvh {bvh.get('layout', '?')} device {j['device_seconds']*1e3:.2f} ms, wall {j['seconds']*1e3:.1f} ms, "
       f"{j['rays']['total']/j['device_seconds']/1e9:.2f} Grays/s, peak device {j['peak_device_bytes']/1e6:.1f} MB "
       f"(alloc {j.get('device_bytes_allocated_peak',0)/1e6:.1f}, meminfo {j.get('device_bytes_meminfo_delta_peak',0)/1e6:.1f}), "
       f"state {j['state_bytes_per_path']} B/path, pif {j['paths_in_flight']}, discarded {j['discarded_samples']}")
@@ -104,6 +108,89 @@ if has ico; then
   for i in 1 2 3; do render ico-pixel-$i $ico --strategy pixel; done
   render ico-wavefront $ico --strategy wavefront
   timeout 60 $PB render --device gpu --quiet $ico --strategy pixel --profile | tee -a "$OUT/summary.txt"
+fi
+
+# Seconds since the script began: the layouts phase leaves out its last, optional
+# pieces (sanitizers, per-layout ctest) past LAYOUTS_BUDGET_S, so that the results are
+# packed before a device call's time limit.
+in_budget() { [ "$SECONDS" -lt "${LAYOUTS_BUDGET_S:-500}" ] || { log "skipped (past ${LAYOUTS_BUDGET_S:-500} s): $*"; return 1; }; }
+
+if has layouts; then
+  layouts=${LAYOUTS:-binary wide4 wide8 brute}
+  ico="--scene paper-cornell-ico:8 --width 256 --height 256 --spp 800 --bounces 2 --sampling nee"
+  log "GPU BVH layouts: paper-cornell 256x256x800 nee, rounds interleaved ($layouts)"
+  for round in 1 2 3; do
+    for l in $layouts; do export PATHBENCH_GPU_BVH=$l; render layout-paper-pixel-$l-$round $paper --strategy pixel; done
+  done
+  for round in 1 2; do
+    for l in $layouts; do export PATHBENCH_GPU_BVH=$l; render layout-paper-wavefront-$l-$round $paper --strategy wavefront; done
+  done
+  log "GPU BVH layouts: paper-cornell-ico:8 (brute force left out: 1.31 M triangles)"
+  for round in 1 2; do
+    for l in ${layouts/brute/}; do export PATHBENCH_GPU_BVH=$l; render layout-ico-pixel-$l-$round $ico --strategy pixel; done
+  done
+  for l in ${layouts/brute/}; do export PATHBENCH_GPU_BVH=$l; render layout-ico-wavefront-$l $ico --strategy wavefront; done
+  for l in $layouts; do
+    export PATHBENCH_GPU_BVH=$l
+    timeout 60 $PB render --device gpu --quiet $paper --strategy pixel --profile > "$OUT/logs/layout-profile-$l.txt" 2>&1
+  done
+  unset PATHBENCH_GPU_BVH
+  log "render medians per layout (device ms)"
+  python3 - "$OUT/json" <<'PY' | tee -a "$OUT/summary.txt"
+import glob, json, os, re, statistics, sys
+runs = {}
+for f in glob.glob(os.path.join(sys.argv[1], "layout-*.json")):
+    m = re.match(r"layout-(paper|ico)-(pixel|wavefront)-(\w+?)(?:-\d+)?\.json$", os.path.basename(f))
+    if not m:
+        continue
+    try:
+        j = json.load(open(f))
+    except Exception:
+        continue
+    runs.setdefault(m.groups(), []).append(j["device_seconds"] * 1e3)
+for key in sorted(runs):
+    v = runs[key]
+    print(f"{key[0]:6s} {key[1]:10s} {key[2]:7s} median {statistics.median(v):8.2f} ms  (n={len(v)}: {', '.join(f'{x:.2f}' for x in v)})")
+PY
+  log "raw ray casts per layout (pathbench-bench --preset gpu-layouts)"
+  timeout 300 $B/bin/pathbench-bench --preset gpu-layouts --benchmark_out="$OUT/json/bench-gpu-layouts.json" \
+    --benchmark_out_format=json > "$OUT/logs/bench-gpu-layouts.txt" 2>&1
+  log "bench rc=$?"
+  python3 - "$OUT/json/bench-gpu-layouts.json" <<'PY' | tee -a "$OUT/summary.txt"
+import json, sys
+try:
+    rows = json.load(open(sys.argv[1]))["benchmarks"]
+except Exception as e:
+    print(f"no bench JSON: {e}"); sys.exit()
+for r in rows:
+    if "rays_per_second" in r:
+        print(f"{r['name']:64s} {r['rays_per_second']/1e9:7.2f} Grays/s")
+    else:
+        print(f"{r['name']:64s} {r.get('error_message', 'no rate')}")
+PY
+  log "GPU tests in each layout (ctest -L gpu)"
+  for l in ${CTEST_LAYOUTS:-wide8 brute binary wide4}; do
+    in_budget "ctest -L gpu in layout $l" || continue
+    export PATHBENCH_GPU_BVH=$l
+    (cd $B && ctest -L gpu --output-on-failure -V --timeout 300) > "$OUT/logs/ctest-gpu-$l.txt" 2>&1
+    log "ctest -L gpu, PATHBENCH_GPU_BVH=$l rc=$?: $(grep -E 'tests passed|tests failed' $OUT/logs/ctest-gpu-$l.txt)"
+    grep -E "FAILED|Failure" "$OUT/logs/ctest-gpu-$l.txt" | sed 's/^[0-9]*: //' | sort -u | head -20 | tee -a "$OUT/summary.txt"
+  done
+  unset PATHBENCH_GPU_BVH
+  log "compute-sanitizer in each layout (paper-cornell-ico:2, 32x32x4)"
+  small_ico="--scene paper-cornell-ico:2 --width 32 --height 32 --spp 4 --bounces 2 --sampling nee --device gpu --quiet"
+  for l in $layouts; do
+    in_budget "sanitizers in layout $l" || continue
+    export PATHBENCH_GPU_BVH=$l
+    for tool in memcheck racecheck; do
+      for st in pixel wavefront; do
+        timeout 120 compute-sanitizer --tool $tool --print-limit 20 $PB render $small_ico --strategy $st \
+          --paths-in-flight 1000 > "$OUT/logs/sanitizer-$tool-$st-$l.txt" 2>&1
+        echo "$l $tool $st: rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' $OUT/logs/sanitizer-$tool-$st-$l.txt)" | tee -a "$OUT/summary.txt"
+      done
+    done
+  done
+  unset PATHBENCH_GPU_BVH
 fi
 
 if has accuracy; then

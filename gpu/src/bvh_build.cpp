@@ -190,6 +190,7 @@ BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options) {
   for (const Vec3f& p : scene.positions) max_coord = std::max({max_coord, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
   const float pad = std::ldexp(std::max(max_coord, 1e-30f), -20);
 
+  out.pad = pad;
   Flattener flat(scene, options, out, pad);
   if (n == 0) {
     Box e;

@@ -6,7 +6,8 @@
 
 #include "cuda_util.h"
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/gpu/traversal.h"
 #include "pathbench/gpu/render.h"
 
 namespace pb::gpu {
@@ -18,11 +19,14 @@ struct GpuScene::Impl {
   DeviceBuffer<Material> materials;
   DeviceBuffer<uint32_t> emitters;
   DeviceBuffer<float> emitter_cdf;
-  DeviceBuffer<BvhNode> nodes;
-  DeviceBuffer<BvhTriangle> tris;
+  DeviceBuffer<BvhNode> nodes;      // the layout's nodes: binary...
+  DeviceBuffer<WideNode> wide_nodes;  // ...or wide (brute force has none)
+  DeviceBuffer<BvhTriangle> tris;    // in traversal order (brute force: scene order)
   SceneView view{};
   BvhView bvh{};
   uint64_t bytes = 0;
+  GpuBvhLayout layout = GpuBvhLayout::Binary;
+  uint32_t bvh_nodes = 0, bvh_node_bytes = 0, bvh_tris = 0;
   uint32_t bvh_depth = 0, bvh_leaves = 0;
   double bvh_sah = 0, bvh_build_seconds = 0;
 };

@@ -19,15 +19,20 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
     launch.launch("generate", k_wf_generate, 0, g.view, c, cur, ctr, spp);
-    launch.launch("intersect", k_wf_intersect, 0, g.bvh, cur, prim_.get(), ctr);
+    with_traversal_kind(g.bvh.kind, [&](auto kind) {  // intersect compiled for the BVH layout
+      launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.bvh, cur, prim_.get(), ctr);
+    });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;
       if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
       else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
     });
     if (shadows_.records) {
-      if (variance) launch.launch("shadow", k_wf_shadow<true>, 0, g.bvh, sh, next, ctr, film);
-      else launch.launch("shadow", k_wf_shadow<false>, 0, g.bvh, sh, next, ctr, film);
+      with_traversal_kind(g.bvh.kind, [&](auto kind) {
+        constexpr int B = decltype(kind)::value;
+        if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, film);
+        else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, film);
+      });
     }
     if (it % kCheckEvery == kCheckEvery - 1) {
       PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));

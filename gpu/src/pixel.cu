@@ -8,7 +8,7 @@
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"
 #include "strategies.cuh"
 
 namespace pb::gpu {
@@ -17,8 +17,8 @@ namespace {
 
 // One path in registers, in scalar type T (the traversal finds the hit triangle in
 // float either way; surface_hit recomputes the hit in T), with the watertight or the
-// Moeller-Trumbore triangle test.
-template <uint32_t Kinds, class T, bool kWatertight>
+// Moeller-Trumbore triangle test, through the BVH layout kKind (traversal.h).
+template <uint32_t Kinds, class T, bool kWatertight, int kKind>
 __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
                                             uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
   PathState<T> st;
@@ -26,7 +26,7 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
   ShadowQuery<T> q;
   auto occlusion_test = [&](const ShadowQuery<T>& query) {  // query: q, filled just before
     ++n_shadow;
-    if (!occluded<kWatertight>(bvh, Vec3f(query.ray.o), Vec3f(query.ray.d), 1.0f)) shadow_unoccluded(st, query);
+    if (!occluded<kWatertight, kKind>(bvh, Vec3f(query.ray.o), Vec3f(query.ray.d), 1.0f)) shadow_unoccluded(st, query);
   };
   for (;;) {
     if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
@@ -35,7 +35,7 @@ __device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& b
     }
     if (st.depth > 0) ++n_bounce;  // the camera ray is counted per path
     float t;
-    const uint32_t prim = intersect_closest<kWatertight>(bvh, Vec3f(st.ray.o), Vec3f(st.ray.d), kInf, t);
+    const uint32_t prim = intersect_closest<kWatertight, kKind>(bvh, Vec3f(st.ray.o), Vec3f(st.ray.d), kInf, t);
     if (prim == kNoHit) break;
     bool wants_shadow;
     const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
@@ -69,7 +69,7 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
   }
 }
 
-template <bool kVariance, uint32_t Kinds, class T, bool kWatertight>
+template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind>
 __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
   kernel_prologue();
@@ -83,7 +83,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
     const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path<Kinds, T, kWatertight>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
+      L = trace_path<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
@@ -98,14 +98,19 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
                       DeviceBuffer<Stats>& stats) {
   PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
-  // In float with the watertight test, or (the accuracy study's variants) in double or
-  // with Moeller-Trumbore.
+  // In float with the watertight test, compiled for the scene's BVH layout; or (the
+  // accuracy study's variants) in double or with Moeller-Trumbore, switching on it.
   with_features(g.view.material_kinds, [&](auto kinds) {
     constexpr uint32_t K = decltype(kinds)::value;
     auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, stats.get()); };
-    if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true>) : go(k_pixel<false, K, double, true>);
-    else if (!watertight) variance ? go(k_pixel<true, K, float, false>) : go(k_pixel<false, K, float, false>);
-    else variance ? go(k_pixel<true, K, float, true>) : go(k_pixel<false, K, float, true>);
+    constexpr int kAny = kAnyKind;
+    if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny>) : go(k_pixel<false, K, double, true, kAny>);
+    else if (!watertight) variance ? go(k_pixel<true, K, float, false, kAny>) : go(k_pixel<false, K, float, false, kAny>);
+    else
+      with_traversal_kind(g.bvh.kind, [&](auto kind) {
+        constexpr int B = decltype(kind)::value;
+        variance ? go(k_pixel<true, K, float, true, B>) : go(k_pixel<false, K, float, true, B>);
+      });
   });
   FrameResult r;
   PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, stats.get(), sizeof(Stats), cudaMemcpyDeviceToHost, stream));

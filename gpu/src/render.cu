@@ -165,9 +165,13 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   x["device_bytes_meminfo_delta_peak"] = mem.peak_meminfo_delta();
   x["film_device_bytes"] = fb.bytes();
   x["scene_device_bytes"] = g.bytes;
-  x["bvh"] = {{"nodes", g.bvh.num_nodes}, {"triangle_refs", g.bvh.num_tris}, {"leaves", g.bvh_leaves},
-              {"depth", g.bvh_depth}, {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
-              {"builder", "embree rtcBuildBVH, binned SAH, binary"}};
+  x["bvh"] = {{"layout", to_string(g.layout)}, {"nodes", g.bvh_nodes}, {"node_bytes", g.bvh_node_bytes},
+              {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth},
+              {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
+              {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
+                          : g.layout == GpuBvhLayout::Binary
+                              ? "embree rtcBuildBVH, binned SAH, binary"
+                              : "embree rtcBuildBVH, binned SAH, binary (leaves <= 3), collapsed greedily"}};
   x["device_samples_per_second"] = device_ms > 0 ? double(r.stats.paths) / (device_ms / 1e3) : 0.0;
   x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
   if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;

@@ -1,17 +1,20 @@
-// The scene upload: the BVH built on the host by Embree's builder (bvh_build.cpp), then
-// every array copied to the device once; a GpuScene serves many renders.
+// The scene upload: the BVH in the chosen layout built on the host (bvh_layout.cpp, by
+// Embree's builder and, for the wide layouts, collapsed), then every array copied to
+// the device once; a GpuScene serves many renders.
 #include <memory>
 
 #include "device_facts.h"
 #include "gpu_scene_impl.cuh"
-#include "pathbench/gpu/bvh_build.h"
+#include "pathbench/gpu/bvh_layout.h"
 
 namespace pb::gpu {
 
-GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+GpuScene::GpuScene(const Scene& scene) : GpuScene(scene, GpuBvhOptions::from_env()) {}
+
+GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std::make_unique<Impl>()) {
   ensure_device();
   Impl& m = *impl_;
-  const BvhHost bvh = build_bvh(scene);
+  const SceneBvhHost bvh = build_scene_bvh(scene, options);
   const char* lower = "the scene's size (fewer triangles)";
   m.positions.assign(scene.positions, "scene vertices", lower);
   m.triangles.assign(scene.triangles, "scene triangles", lower);
@@ -19,8 +22,11 @@ GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   m.materials.assign(scene.materials, "materials", lower);
   m.emitters.assign(scene.emitters, "emitter table", lower);
   m.emitter_cdf.assign(scene.emitter_cdf, "emitter table", lower);
-  m.nodes.assign(bvh.nodes, "BVH nodes", lower);
-  m.tris.assign(bvh.tris, "BVH triangles", lower);
+  m.nodes.assign(bvh.binary.nodes, "BVH nodes", lower);
+  m.wide_nodes.assign(bvh.wide.nodes, "BVH nodes", lower);
+  m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : bvh.layout == GpuBvhLayout::Binary ? bvh.binary.tris
+                                                                                                  : bvh.wide.tris,
+                "BVH triangles", lower);
   m.view = scene.view();
   m.view.positions = m.positions.get();
   m.view.triangles = m.triangles.get();
@@ -28,12 +34,20 @@ GpuScene::GpuScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   m.view.materials = m.materials.get();
   m.view.emitters = m.emitters.get();
   m.view.emitter_cdf = m.emitter_cdf.get();
-  m.bvh = {m.nodes.get(), m.tris.get(), uint32_t(bvh.nodes.size()), uint32_t(bvh.tris.size())};
+  // The host view with the device's pointers in place of the host's.
+  m.bvh = bvh.view();
+  m.bvh.binary = {m.nodes.get(), m.tris.get(), uint32_t(m.nodes.size()), uint32_t(m.tris.size())};
+  m.bvh.wide = {m.wide_nodes.get(), m.tris.get(), uint32_t(m.wide_nodes.size()), uint32_t(m.tris.size())};
+  m.bvh.tris = m.tris.get();
   m.bytes = m.positions.bytes() + m.triangles.bytes() + m.material_ids.bytes() + m.materials.bytes() +
-            m.emitters.bytes() + m.emitter_cdf.bytes() + m.nodes.bytes() + m.tris.bytes();
-  m.bvh_depth = bvh.depth;
-  m.bvh_leaves = bvh.leaves;
-  m.bvh_sah = bvh.sah_cost;
+            m.emitters.bytes() + m.emitter_cdf.bytes() + m.nodes.bytes() + m.wide_nodes.bytes() + m.tris.bytes();
+  m.layout = bvh.layout;
+  m.bvh_nodes = bvh.nodes();
+  m.bvh_node_bytes = bvh.node_bytes();
+  m.bvh_tris = uint32_t(m.tris.size());
+  m.bvh_depth = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_depth : bvh.wide.depth;
+  m.bvh_leaves = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_leaves : bvh.wide.leaves;
+  m.bvh_sah = bvh.binary_sah;
   m.bvh_build_seconds = bvh.build_seconds;
 }
 

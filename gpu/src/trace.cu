@@ -10,19 +10,21 @@
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"
 #include "pathbench/gpu/render.h"
 
 namespace pb::gpu {
 
 namespace {
-// Traversal for tests.
+// Traversal for tests and the ray-cast benchmarks, compiled for the BVH layout.
+template <int kKind>
 __global__ void k_trace(BvhView bvh, const TraceQuery* rays, TraceResult* out, uint32_t n, bool any_hit) {
   kernel_prologue();
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const TraceQuery r = rays[i];
     float t = r.t_max;
-    uint32_t prim = any_hit ? traverse<true>(bvh, r.o, r.d, r.t_max, t) : traverse<false>(bvh, r.o, r.d, r.t_max, t);
+    uint32_t prim = any_hit ? traverse<true, true, kKind>(bvh, r.o, r.d, r.t_max, t)
+                            : traverse<false, true, kKind>(bvh, r.o, r.d, r.t_max, t);
     out[i] = {prim, t};
   }
 }
@@ -30,15 +32,23 @@ __global__ void k_trace(BvhView bvh, const TraceQuery* rays, TraceResult* out, u
 }  // namespace
 
 std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit) {
+  return trace_on_device(scene, rays, any_hit, GpuBvhOptions::from_env());
+}
+
+std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit,
+                                         const GpuBvhOptions& options) {
   ensure_device();
-  const GpuScene gs(scene);
+  const GpuScene gs(scene, options);
   DeviceBuffer<TraceQuery> d_rays(rays.size(), "test rays", "the number of rays");
   DeviceBuffer<TraceResult> d_out(rays.size(), "test results", "the number of rays");
   d_rays.upload(rays.data(), rays.size());
   std::vector<TraceResult> out(rays.size());
   if (rays.empty()) return out;
   Launcher launch(nullptr, false);
-  launch.launch("trace", k_trace, rays.size(), gs.impl().bvh, d_rays.get(), d_out.get(), uint32_t(rays.size()), any_hit);
+  with_traversal_kind(gs.impl().bvh.kind, [&](auto kind) {
+    launch.launch("trace", k_trace<decltype(kind)::value>, rays.size(), gs.impl().bvh, d_rays.get(), d_out.get(),
+                  uint32_t(rays.size()), any_hit);
+  });
   PB_CUDA_CHECK(cudaDeviceSynchronize());
   d_out.download(out.data(), out.size());
   return out;
@@ -58,7 +68,9 @@ std::vector<double> time_trace_on_device(const GpuScene& gs, const std::vector<T
   for (int r = -1; r < repeats; ++r) {  // r = -1: warm-up, not timed
     PB_CUDA_CHECK(cudaMemset(d_out.get(), 0xAB, sizeof(TraceResult) * n));  // poison
     PB_CUDA_CHECK(cudaEventRecord(start.e, nullptr));
-    launch.launch("trace", k_trace, n, gs.impl().bvh, d_rays.get(), d_out.get(), n, any_hit);
+    with_traversal_kind(gs.impl().bvh.kind, [&](auto kind) {
+      launch.launch("trace", k_trace<decltype(kind)::value>, n, gs.impl().bvh, d_rays.get(), d_out.get(), n, any_hit);
+    });
     PB_CUDA_CHECK(cudaEventRecord(stop.e, nullptr));
     PB_CUDA_CHECK(cudaEventSynchronize(stop.e));
     float ms = 0;

@@ -9,7 +9,7 @@
 #include "device_film.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"
 #include "wavefront_state.cuh"
 
 namespace pb::gpu {
@@ -51,13 +51,20 @@ __global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig 
   }
 }
 
-__global__ void __launch_bounds__(256, 5) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+// Blocks an SM for the traversal stages: 5 (48 registers) suits the binary and brute-force
+// traversals; the wide one holds a node's 20 words and spills under 48 (ptxas: 28 B in
+// intersect, 100 B in shadow), so it gets 4 (64 registers).
+template <int kKind>
+constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
+
+template <int kKind>  // the BVH layout (traversal.h)
+__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
   kernel_prologue();
   const uint32_t n = ctr->n_cur;
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     const float4 o = cur.o[i], d = cur.d[i];
     float t;
-    prim[i] = intersect_closest(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
+    prim[i] = intersect_closest<true, kKind>(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
   }
 }
 
@@ -125,8 +132,8 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
   }
 }
 
-template <bool kVariance>
-__global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
+template <bool kVariance, int kKind>
+__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
                                                       FilmDev film) {
   kernel_prologue();
   const uint32_t n = ctr->n_shadow;
@@ -141,7 +148,7 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
       const float2 ct = sh.ct[i];
       const uint32_t target = __float_as_uint(ct.y);
       const Vec3f origin{o.x, o.y, o.z};
-      const bool visible = !occluded(bvh, origin, {d.x, d.y, d.z}, 1.0f);
+      const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
       if (target & kShadowDone) {
         const float4 l = sh.L[i];
         L = {l.x, l.y, l.z};
@@ -149,7 +156,7 @@ __global__ void __launch_bounds__(256, 5) k_wf_shadow(BvhView bvh, ShadowSoA sh,
         if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
           const float4 d2 = sh.d2[i];
           const float2 c2 = sh.c2[i];
-          if (!occluded(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
+          if (!occluded<true, kKind>(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
         }
         add = true;
         pixel = target & ~kShadowDone;

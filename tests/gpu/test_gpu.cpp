@@ -11,6 +11,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/gpu/bvh_build.h"
+#include "pathbench/gpu/bvh_layout.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "traversal_check.h"
@@ -182,18 +183,22 @@ TEST(GpuVsCpu, CornellBoxGgx) {  // rough conductor
   gpu_vs_cpu("cornell-box:ggx");
 }
 
-// The traversal cross-check of tests/gpu/test_traversal.cpp, run on the device: the
-// device traversal returns what the host traversal returns, and agrees with Embree.
+// The traversal cross-check of tests/gpu/test_traversal.cpp, run on the device in
+// every BVH layout: the device traversal returns what the host traversal of the same
+// layout returns, and agrees with Embree.
 TEST(GpuTraversal, DeviceMatchesHostAndEmbree) {
   PB_REQUIRE_GPU();
-  for (const char* name : {"paper-cornell", "paper-cornell-ico:3"}) {
+  for (const char* name : {"paper-cornell", "paper-cornell-ico:3"})
+  for (GpuBvhLayout layout : {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8, GpuBvhLayout::Brute}) {
     Scene scene;
     try {
       scene = load_scene(name);
     } catch (const InputError&) {
       continue;
     }
-    const BvhHost bvh = build_bvh(scene);
+    GpuBvhOptions options;
+    options.layout = layout;
+    const SceneBvhHost bvh = build_scene_bvh(scene, options);
     const Vec3f ext = scene.bounds_max - scene.bounds_min;
     const Vec3f lo = scene.bounds_min + ext * 0.02f, hi = scene.bounds_max - ext * 0.02f;
     auto rays = test::random_rays(lo, hi, 20000, 9);
@@ -201,7 +206,7 @@ TEST(GpuTraversal, DeviceMatchesHostAndEmbree) {
     rays.insert(rays.end(), edge.begin(), edge.end());
     std::vector<TraceQuery> q(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) q[i] = {rays[i].o, rays[i].d, rays[i].t_max};
-    const auto dev = trace_on_device(scene, q, false);
+    const auto dev = trace_on_device(scene, q, false, options);
     const test::EmbreeReference ref(scene);
     test::Agreement with_host, with_embree;
     with_embree.edge_rays = true;  // random rays plus rays aimed at edges (see test_traversal.cpp)
@@ -215,9 +220,9 @@ TEST(GpuTraversal, DeviceMatchesHostAndEmbree) {
       const test::Hit e = ref.closest(rays[i]);
       if (e.prim != kNoHit) with_embree.add(rays[i], d, e, test::hit_cos(scene, rays[i], d));
     }
-    std::printf("[ INFO     ] %s device traversal: %zu rays; vs host: %zu hit/miss, %zu prim (%zu not ties), %zu t; "
+    std::printf("[ INFO     ] %s %s device traversal: %zu rays; vs host: %zu hit/miss, %zu prim (%zu not ties), %zu t; "
                 "vs Embree: %zu hit/miss, %zu prim (%zu not ties), %zu t; %zu misses\n",
-                name, rays.size(), with_host.hit_miss_mismatch, with_host.prim_mismatch, with_host.prim_mismatch_not_tie,
+                name, to_string(layout), rays.size(), with_host.hit_miss_mismatch, with_host.prim_mismatch, with_host.prim_mismatch_not_tie,
                 with_host.t_mismatch, with_embree.hit_miss_mismatch, with_embree.prim_mismatch,
                 with_embree.prim_mismatch_not_tie, with_embree.t_mismatch, misses);
     EXPECT_EQ(misses, 0u) << name << ": closed scene, every ray must hit";

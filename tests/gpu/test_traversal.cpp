@@ -1,15 +1,21 @@
 // Host-side checks of the GPU tracer's BVH (built by Embree's builder) and its
 // host+device traversal with the watertight triangle test, against Embree's own
-// intersector on the same rays. Runs without a GPU (CTest label `unit`).
+// intersector on the same rays, in every layout (binary, wide4, wide8, brute force:
+// bvh_layout.h); the wide and brute-force layouts also against the binary BVH, hit for
+// hit. Runs without a GPU (CTest label `unit`).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ostream>
 #include <random>
+#include <string>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/gpu/bvh_build.h"
+#include "pathbench/gpu/bvh_layout.h"
 #include "traversal_check.h"
 
 namespace pb::gpu {
@@ -23,9 +29,12 @@ using test::Ray3;
 struct SceneCase {
   const char* name;
   bool closed;  // every ray from inside must hit something
+  GpuBvhLayout layout = GpuBvhLayout::Binary;
 };
 
-void PrintTo(const SceneCase& c, std::ostream* os) { *os << c.name << (c.closed ? " (closed)" : ""); }
+void PrintTo(const SceneCase& c, std::ostream* os) {
+  *os << c.name << (c.closed ? " (closed)" : "") << " " << to_string(c.layout);
+}
 
 Scene load_or_skip(const char* name, bool& ok) {
   ok = true;
@@ -37,9 +46,9 @@ Scene load_or_skip(const char* name, bool& ok) {
   }
 }
 
-Hit trace_host(const BvhHost& bvh, const Ray3& r) {
+Hit trace_host(const BvhView& bvh, const Ray3& r, TraversalStats* stats = nullptr) {
   Hit h;
-  h.prim = traverse<false>(bvh.view(), r.o, r.d, r.t_max, h.t);
+  h.prim = traverse<false>(bvh, r.o, r.d, r.t_max, h.t, stats);
   return h;
 }
 
@@ -49,36 +58,54 @@ class Traversal : public ::testing::TestWithParam<SceneCase> {
     bool ok;
     scene_ = load_or_skip(GetParam().name, ok);
     if (!ok) GTEST_SKIP() << "scene " << GetParam().name << " is not built in yet";
-    bvh_ = build_bvh(scene_);
+    GpuBvhOptions o;
+    o.layout = GetParam().layout;
+    bvh_ = build_scene_bvh(scene_, o);
+    view_ = bvh_.view();
     // Origins strictly inside the scene's bounds.
     const Vec3f ext = scene_.bounds_max - scene_.bounds_min;
     lo_ = scene_.bounds_min + ext * 0.02f;
     hi_ = scene_.bounds_max - ext * 0.02f;
   }
   Scene scene_;
-  BvhHost bvh_;
+  SceneBvhHost bvh_;
+  BvhView view_;
   Vec3f lo_, hi_;
 };
 
 TEST_P(Traversal, BvhReferencesEveryTriangle) {
+  const std::vector<BvhTriangle>& tris = bvh_.layout == GpuBvhLayout::Brute    ? bvh_.all
+                                         : bvh_.layout == GpuBvhLayout::Binary ? bvh_.binary.tris
+                                                                               : bvh_.wide.tris;
   std::vector<int> seen(scene_.triangles.size(), 0);
-  for (const BvhTriangle& t : bvh_.tris) {
+  for (const BvhTriangle& t : tris) {
     ASSERT_LT(t.prim, scene_.triangles.size());
     seen[t.prim] = 1;
   }
   for (size_t i = 0; i < seen.size(); ++i) EXPECT_TRUE(seen[i]) << "triangle " << i << " is in no leaf";
-  EXPECT_FALSE(is_leaf(0));
-  EXPECT_LT(bvh_.depth + 1, uint32_t(kTraversalStackSize));
-  std::printf("[ INFO     ] %s: %zu triangles, %zu nodes, %u leaves, depth %u, SAH cost %.2f, built in %.3f s\n",
-              GetParam().name, scene_.triangles.size(), bvh_.nodes.size(), bvh_.leaves, bvh_.depth, bvh_.sah_cost,
-              bvh_.build_seconds);
+  const uint32_t depth = bvh_.layout == GpuBvhLayout::Binary ? bvh_.binary.depth : bvh_.wide.depth;
+  if (bvh_.layout == GpuBvhLayout::Binary) {
+    EXPECT_FALSE(is_leaf(0));
+    EXPECT_LT(depth + 1, uint32_t(kTraversalStackSize));
+  }
+  if (bvh_.layout == GpuBvhLayout::Wide4 || bvh_.layout == GpuBvhLayout::Wide8) {
+    EXPECT_EQ(tris.size(), scene_.triangles.size());  // each triangle in exactly one leaf
+    EXPECT_LT(depth + 1, uint32_t(kWideStackSize));
+  }
+  std::printf("[ INFO     ] %s %s: %zu triangles, %u nodes of %u bytes, %.2f MB, depth %u (binary: depth %u, %u "
+              "leaves, SAH %.2f), built in %.3f s\n",
+              GetParam().name, to_string(bvh_.layout), scene_.triangles.size(), bvh_.nodes(), bvh_.node_bytes(),
+              bvh_.bytes() / 1e6, depth, bvh_.binary_depth, bvh_.binary_leaves, bvh_.binary_sah, bvh_.build_seconds);
 }
 
 TEST_P(Traversal, RandomRaysAgreeWithEmbree) {
   const EmbreeReference ref(scene_);
   const auto rays = test::random_rays(lo_, hi_, 20000, 7);
   Agreement a;
-  for (const Ray3& r : rays) a.add(r, trace_host(bvh_, r), ref.closest(r));
+  TraversalStats stats;
+  for (const Ray3& r : rays) a.add(r, trace_host(view_, r, &stats), ref.closest(r));
+  std::printf("[ INFO     ] %s %s random: %.2f nodes, %.2f triangles a ray\n", GetParam().name, to_string(bvh_.layout),
+              double(stats.nodes) / rays.size(), double(stats.tris) / rays.size());
   std::printf("[ INFO     ] %s random: %zu rays, %zu hit/miss, %zu prim (%zu not ties), %zu t mismatches, %zu misses\n",
               GetParam().name, a.rays, a.hit_miss_mismatch, a.prim_mismatch, a.prim_mismatch_not_tie, a.t_mismatch,
               a.misses);
@@ -95,7 +122,7 @@ TEST_P(Traversal, RaysThroughEdgesAndVerticesNeverPassBetweenTriangles) {
   a.edge_rays = true;
   size_t ref_misses_we_hit = 0;
   for (const Ray3& r : rays) {
-    const Hit ours = trace_host(bvh_, r), theirs = ref.closest(r);
+    const Hit ours = trace_host(view_, r), theirs = ref.closest(r);
     if (theirs.prim == kNoHit && ours.prim != kNoHit) {
       ++ref_misses_we_hit;  // Embree (not in robust mode) may slip through an edge
       continue;
@@ -123,7 +150,7 @@ TEST_P(Traversal, OcclusionAgreesWithEmbree) {
     };
     const Vec3f a = point(), b = point();
     const Ray3 r{a, b - a, 1.0f};
-    const bool ours = occluded(bvh_.view(), r.o, r.d, 1.0f);
+    const bool ours = occluded(view_, r.o, r.d, 1.0f);
     occluded_count += ours;
     if (ours != ref.occluded(r)) ++mismatches;
   }
@@ -132,15 +159,95 @@ TEST_P(Traversal, OcclusionAgreesWithEmbree) {
   EXPECT_LE(mismatches, n / 10000);  // only segments ending within rounding of a surface
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, Traversal,
-                         ::testing::Values(SceneCase{"paper-cornell", true}, SceneCase{"paper-cornell-ico:3", true},
-                                           SceneCase{"cornell-box", false}),
-                         [](const auto& info) {
-                           std::string n = info.param.name;
-                           for (char& c : n)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return n;
-                         });
+std::string case_name(const ::testing::TestParamInfo<SceneCase>& info) {
+  std::string n = info.param.name;
+  if (info.param.layout != GpuBvhLayout::Binary) n += std::string("_") + to_string(info.param.layout);
+  for (char& c : n)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return n;
+}
+
+// Brute force only on the small scenes: it tests every triangle for every ray.
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, Traversal,
+    ::testing::Values(SceneCase{"paper-cornell", true}, SceneCase{"paper-cornell-ico:3", true},
+                      SceneCase{"cornell-box", false}, SceneCase{"paper-cornell", true, GpuBvhLayout::Wide8},
+                      SceneCase{"paper-cornell-ico:3", true, GpuBvhLayout::Wide8},
+                      SceneCase{"cornell-box", false, GpuBvhLayout::Wide8},
+                      SceneCase{"paper-cornell", true, GpuBvhLayout::Wide4},
+                      SceneCase{"paper-cornell-ico:3", true, GpuBvhLayout::Wide4},
+                      SceneCase{"cornell-box", false, GpuBvhLayout::Wide4},
+                      SceneCase{"paper-cornell", true, GpuBvhLayout::Brute}),
+    case_name);
+
+// Every layout against the binary BVH on the same rays, by the rules the Embree
+// comparison uses (a different triangle only at the same t, or at the aimed-at edge of
+// an edge ray, where Woop's t orders two grazed triangles by the order of the tests);
+// where both find the same triangle, the same t bit for bit (the same watertight test
+// and plane_distance); the same any-hit answer on every segment.
+class LayoutsAgree : public ::testing::TestWithParam<SceneCase> {};
+
+TEST_P(LayoutsAgree, SameHitsAsTheBinaryBvh) {
+  bool ok;
+  const Scene scene = load_or_skip(GetParam().name, ok);
+  if (!ok) GTEST_SKIP() << "scene " << GetParam().name << " is not built in yet";
+  GpuBvhOptions o;
+  const SceneBvhHost binary = build_scene_bvh(scene, o);
+  o.layout = GetParam().layout;
+  const SceneBvhHost other = build_scene_bvh(scene, o);
+  const Vec3f ext = scene.bounds_max - scene.bounds_min;
+  const Vec3f lo = scene.bounds_min + ext * 0.02f, hi = scene.bounds_max - ext * 0.02f;
+  const std::vector<Ray3> random = test::random_rays(lo, hi, 20000, 17);
+  const std::vector<Ray3> edges = test::edge_and_vertex_rays(scene, lo, hi, 6, 19, 1024);
+  Agreement on_random, on_edges;
+  on_edges.edge_rays = true;
+  size_t hits = 0, t_differs = 0, occlusion_differs = 0, rays = 0;
+  for (const Ray3& r : random) on_random.add(r, trace_host(other.view(), r), trace_host(binary.view(), r));
+  for (const Ray3& r : edges) {
+    const Hit b = trace_host(other.view(), r);
+    on_edges.add(r, b, trace_host(binary.view(), r), test::hit_cos(scene, r, b));
+  }
+  for (const std::vector<Ray3>* set : {&random, &edges})
+  for (const Ray3& r : *set) {
+    ++rays;
+    const Hit a = trace_host(binary.view(), r), b = trace_host(other.view(), r);
+    hits += a.prim != kNoHit;
+    if (a.prim == b.prim && a.prim != kNoHit && a.t != b.t) ++t_differs;
+    // Segments to 0.999 of the way to the closest hit (unoccluded) and to the far side
+    // of it (occluded), as a shadow ray's t_max = 1 against its target.
+    if (a.prim != kNoHit) {
+      for (float f : {0.999f, 1.001f}) {
+        const Vec3f d = r.d * (a.t * f);
+        if (occluded(binary.view(), r.o, d, 1.0f) != occluded(other.view(), r.o, d, 1.0f)) ++occlusion_differs;
+      }
+    }
+  }
+  std::printf("[ INFO     ] %s %s vs binary: %zu rays, %zu hits; random: %zu other triangles (%zu not ties); edges: "
+              "%zu other triangles (%zu not ties, %zu at the aimed-at edge); %zu t differ, %zu occlusion answers "
+              "differ\n",
+              GetParam().name, to_string(GetParam().layout), rays, hits, on_random.prim_mismatch,
+              on_random.prim_mismatch_not_tie, on_edges.prim_mismatch, on_edges.prim_mismatch_not_tie,
+              on_edges.at_target_edge, t_differs, occlusion_differs);
+  EXPECT_GT(hits, rays / 2);
+  for (const Agreement* a : {&on_random, &on_edges}) {
+    EXPECT_EQ(a->hit_miss_mismatch, 0u) << a->first_problem;
+    EXPECT_EQ(a->prim_mismatch_not_tie, 0u) << a->first_problem;
+    EXPECT_EQ(a->t_mismatch, 0u) << a->first_problem;
+  }
+  EXPECT_EQ(t_differs, 0u);
+  EXPECT_EQ(occlusion_differs, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, LayoutsAgree,
+                         ::testing::Values(SceneCase{"paper-cornell", true, GpuBvhLayout::Wide8},
+                                           SceneCase{"paper-cornell", true, GpuBvhLayout::Wide4},
+                                           SceneCase{"paper-cornell", true, GpuBvhLayout::Brute},
+                                           SceneCase{"paper-cornell-ico:0", true, GpuBvhLayout::Brute},
+                                           SceneCase{"paper-cornell-ico:1", true, GpuBvhLayout::Brute},
+                                           SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::Wide8},
+                                           SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::Wide4},
+                                           SceneCase{"cornell-box", false, GpuBvhLayout::Wide8}),
+                         case_name);
 
 // A square split into four triangles around its centre: rays exactly through the shared
 // centre vertex and through points of the shared diagonals hit at least one triangle.
@@ -185,10 +292,74 @@ TEST(Watertight, RespectsTheInterval) {
 TEST(Bvh, EmptySceneMissesEverything) {
   Scene s;
   s.name = "empty";
-  const BvhHost bvh = build_bvh(s);
-  float t;
-  EXPECT_EQ(traverse<false>(bvh.view(), {0, 0, 0}, {0, 0, 1}, 1e30f, t), kNoHit);
-  EXPECT_FALSE(occluded(bvh.view(), {0, 0, 0}, {1, 1, 1}, 1.0f));
+  for (GpuBvhLayout l : {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8, GpuBvhLayout::Brute}) {
+    GpuBvhOptions o;
+    o.layout = l;
+    const SceneBvhHost bvh = build_scene_bvh(s, o);
+    float t;
+    EXPECT_EQ(traverse<false>(bvh.view(), {0, 0, 0}, {0, 0, 1}, 1e30f, t), kNoHit) << to_string(l);
+    EXPECT_FALSE(occluded(bvh.view(), {0, 0, 0}, {1, 1, 1}, 1.0f)) << to_string(l);
+  }
+}
+
+// The layout choice: auto takes brute force up to the threshold, else the wide BVH; the
+// environment's names are checked, and a bad one is an InputError naming the variable.
+TEST(BvhLayout, AutoAndNames) {
+  GpuBvhOptions o;
+  o.brute_max_triangles = 20;
+  EXPECT_EQ(resolve_layout(o, 20), GpuBvhLayout::Brute);
+  EXPECT_EQ(resolve_layout(o, 21), kAutoLayout);
+  o.layout = GpuBvhLayout::Binary;
+  EXPECT_EQ(resolve_layout(o, 5), GpuBvhLayout::Binary);
+  for (GpuBvhLayout l : {GpuBvhLayout::Auto, GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,
+                         GpuBvhLayout::Brute})
+    EXPECT_EQ(parse_gpu_bvh_layout(to_string(l)), l);
+  try {
+    parse_gpu_bvh_layout("wide16");
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("PATHBENCH_GPU_BVH"), std::string::npos) << e.what();
+  }
+  ::setenv("PATHBENCH_GPU_BRUTE_MAX_TRIS", "12x", 1);
+  EXPECT_THROW(GpuBvhOptions::from_env(), InputError);
+  ::setenv("PATHBENCH_GPU_BRUTE_MAX_TRIS", "7", 1);
+  ::setenv("PATHBENCH_GPU_BVH", "wide4", 1);
+  const GpuBvhOptions e = GpuBvhOptions::from_env();
+  EXPECT_EQ(e.brute_max_triangles, 7u);
+  EXPECT_EQ(e.layout, GpuBvhLayout::Wide4);
+  ::unsetenv("PATHBENCH_GPU_BRUTE_MAX_TRIS");
+  ::unsetenv("PATHBENCH_GPU_BVH");
+}
+
+// The quantised child boxes hold the children they stand for: every triangle of a
+// wide leaf lies inside its slot's box, decoded exactly (in double).
+TEST(WideBvh, QuantisedBoxesHoldTheirTriangles) {
+  const Scene scene = load_scene("paper-cornell-ico:3");
+  GpuBvhOptions o;
+  o.layout = GpuBvhLayout::Wide8;
+  const SceneBvhHost b = build_scene_bvh(scene, o);
+  size_t checked = 0, children = 0;
+  for (const WideNode& n : b.wide.nodes) {
+    for (uint32_t s = 0; s < 8; ++s) {
+      if (n.meta[s] == 0) continue;
+      ++children;
+      if ((n.imask >> s) & 1u) continue;
+      const uint32_t count = n.meta[s] >> 5 == 7 ? 3 : n.meta[s] >> 5 == 3 ? 2 : 1;
+      for (uint32_t k = 0; k < count; ++k) {
+        const BvhTriangle& t = b.wide.tris[n.tri_base + (n.meta[s] & 31u) + k];
+        for (const float* v : {t.v0, t.v1, t.v2})
+          for (int a = 0; a < 3; ++a) {
+            const double step = std::ldexp(1.0, int(n.e[a]) - 127);
+            EXPECT_LE(double(n.p[a]) + n.qlo[a][s] * step, double(v[a]));
+            EXPECT_GE(double(n.p[a]) + n.qhi[a][s] * step, double(v[a]));
+          }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, scene.triangles.size());
+  std::printf("[ INFO     ] wide8 on %zu triangles: %zu nodes, %.2f children a node\n", scene.triangles.size(),
+              b.wide.nodes.size(), double(children) / b.wide.nodes.size());
 }
 
 }  // namespace

@@ -44,8 +44,9 @@ struct alignas(16) BvhTriangle {
 };
 static_assert(sizeof(BvhTriangle) == 48, "BvhTriangle is 48 bytes");
 
-// What the traversal reads: host or device pointers.
-struct BvhView {
+// What the binary traversal reads: host or device pointers. (The kernels get a BvhView,
+// traversal.h: the scene's BVH in whichever layout it was built.)
+struct BinaryBvhView {
   const BvhNode* nodes;      // node 0 is the root, always an inner node
   const BvhTriangle* tris;
   uint32_t num_nodes;
@@ -108,16 +109,37 @@ PB_HD float safe_inverse(float d) {
   return 1.0f / (std::fabs(d) > kTiny ? d : (d >= 0.0f ? kTiny : -kTiny));
 }
 
+// Tests triangle slot i of `tris` for a hit closer than t; on a hit narrows t to it and
+// records the triangle (scene id and slot). Every traversal's leaf test.
+template <bool kWatertight>
+PB_HD bool test_triangle(const BvhTriangle* tris, uint32_t i, const WatertightRay& wr, const Vec3f& o, const Vec3f& d,
+                         float& t, uint32_t& hit, uint32_t& hit_slot, TraversalStats* stats) {
+  Vec3f a, b, c;
+  uint32_t prim;
+  load_triangle(tris, i, a, b, c, prim);
+  if (stats) ++stats->tris;
+  float tt;
+  bool h;
+  if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
+  else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
+  if (h) {
+    t = tt;
+    hit = prim;
+    hit_slot = i;
+  }
+  return h;
+}
+
 // The closest hit's answer. Woop's t ordered the candidates; the winner's t comes from
 // the plane equation in double (watertight.h), accurate on grazing rays too.
 template <bool kWatertight>
-PB_HD uint32_t finish_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, uint32_t hit,
+PB_HD uint32_t finish_closest(const BvhTriangle* tris, const Vec3f& o, const Vec3f& d, float t_max, uint32_t hit,
                               uint32_t slot, float t, float& t_hit) {
   t_hit = t;
   if (kWatertight && hit != kNoHit) {
     Vec3f a, b, c;
     uint32_t prim;
-    load_triangle(bvh.tris, slot, a, b, c, prim);
+    load_triangle(tris, slot, a, b, c, prim);
     const float exact = plane_distance(o, d, a, b, c);
     if (exact > 0.0f && exact < t_max) t_hit = exact;
   }
@@ -131,7 +153,7 @@ PB_HD uint32_t finish_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d
 // t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
 // Moeller-Trumbore (the paper's; the accuracy study's comparison).
 template <bool kAnyHit, bool kWatertight = true>
-PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
+PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
   const WatertightRay wr = make_watertight_ray(o, d);
   const Vec3f inv = {detail::safe_inverse(d.x), detail::safe_inverse(d.y), detail::safe_inverse(d.z)};
@@ -167,39 +189,29 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       } else if (h0 || h1) {
         ref = h0 ? child[0] : child[1];
       } else {
-        if (sp == 0) return detail::finish_closest<kWatertight>(bvh, o, d, t_max, hit, hit_slot, t, t_hit);
+        if (sp == 0) return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
         ref = stack[--sp];
       }
     }
     const uint32_t first = leaf_first(ref), count = leaf_count(ref);
     for (uint32_t i = first; i < first + count; ++i) {
-      Vec3f a, b, c;
-      uint32_t prim;
-      detail::load_triangle(bvh.tris, i, a, b, c, prim);
-      if (stats) ++stats->tris;
-      float tt;
-      bool h;
-      if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
-      else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
-      if (h) {
-        t = tt;
-        hit = prim;
-        hit_slot = i;
-        if (kAnyHit) { t_hit = t; return hit; }
+      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+        t_hit = t;
+        return hit;
       }
     }
     if (sp == 0) break;
     ref = stack[--sp];
   }
-  return detail::finish_closest<kWatertight>(bvh, o, d, t_max, hit, hit_slot, t, t_hit);
+  return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
 template <bool kWatertight = true>
-PB_HD uint32_t intersect_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
+PB_HD uint32_t intersect_closest(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
   return traverse<false, kWatertight>(bvh, o, d, t_max, t_hit);
 }
 template <bool kWatertight = true>
-PB_HD bool occluded(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
+PB_HD bool occluded(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
   float t;
   return traverse<true, kWatertight>(bvh, o, d, t_max, t) != kNoHit;
 }

@@ -7,6 +7,7 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
 
 namespace pb::gpu {
 
@@ -24,8 +25,9 @@ struct BvhHost {
   uint32_t leaves = 0;
   double sah_cost = 0;      // expected cost of a random ray, in the options' units
   double build_seconds = 0;
+  float pad = 0;            // every box was grown by this (a few ulps of the largest coordinate)
 
-  BvhView view() const {
+  BinaryBvhView view() const {
     return {nodes.data(), tris.data(), uint32_t(nodes.size()), uint32_t(tris.size())};
   }
   uint64_t bytes() const { return nodes.size() * sizeof(BvhNode) + tris.size() * sizeof(BvhTriangle); }

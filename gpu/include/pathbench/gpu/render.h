@@ -41,10 +41,15 @@ int select_device(int local_rank);
 // Visible CUDA devices (0 where none).
 int device_count();
 
+struct GpuBvhOptions;  // bvh_layout.h
+
 // The scene on the device: arrays and BVH, uploaded once, reusable for many renders.
+// The BVH's layout comes from `options` (binary, wide4, wide8, brute force; bvh_layout.h),
+// or from the environment (GpuBvhOptions::from_env: PATHBENCH_GPU_BVH, ...).
 class GpuScene {
  public:
   explicit GpuScene(const Scene& scene);
+  GpuScene(const Scene& scene, const GpuBvhOptions& options);
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
@@ -79,6 +84,8 @@ struct TraceResult {
   float t;
 };
 std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit);
+std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<TraceQuery>& rays, bool any_hit,
+                                         const GpuBvhOptions& options);
 
 // Ray casting alone, for the raw ray-cast benchmarks: the rays are uploaded once, the
 // traversal kernel runs once to warm up, then `repeats` launches are each timed with

@@ -1,0 +1,77 @@
+#pragma once
+// What the kernels trace against: the scene's BVH in the layout it was built in
+// (bvh_layout.h picks it), and the one traversal entry that dispatches on it. The
+// layout is the same for every thread of a launch, so a run-time switch never
+// diverges; but a kernel that holds all three traversals is register-allocated for the
+// largest, so the hot kernels are compiled once per kind (kKind, with_traversal_kind)
+// and only the rest switch at run time (kAnyKind).
+#include <cstdint>
+#include <type_traits>
+
+#include "pathbench/common/hd.h"
+#include "pathbench/gpu/brute_force.h"
+#include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/wide_bvh.h"
+
+namespace pb::gpu {
+
+// Binary: bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
+// brute_force.h, the triangles in scene order in `tris` and no nodes.
+enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2 };
+
+struct BvhView {
+  BvhView() = default;
+  // A binary BVH alone (BvhHost::view()) is a BvhView as it stands.
+  PB_HD BvhView(const BinaryBvhView& b) : kind(TraversalKind::Binary), binary(b) {}  // NOLINT: implicit on purpose
+  TraversalKind kind = TraversalKind::Binary;
+  BinaryBvhView binary{};
+  WideBvhView wide{};
+  const BvhTriangle* tris = nullptr;  // AllTriangles
+  uint32_t num_tris = 0;
+};
+
+// kKind: a TraversalKind the caller was compiled for (bvh.kind must be it), or
+// kAnyKind to switch on bvh.kind.
+constexpr int kAnyKind = -1;
+
+template <bool kAnyHit, bool kWatertight = true, int kKind = kAnyKind>
+PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
+                        TraversalStats* stats = nullptr) {
+  if constexpr (kKind == int(TraversalKind::Wide)) {
+    return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::AllTriangles)) {
+    return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::Binary)) {
+    return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
+  } else {
+    switch (bvh.kind) {
+      case TraversalKind::Wide: return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
+      case TraversalKind::AllTriangles:
+        return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats);
+      default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
+    }
+  }
+}
+
+template <bool kWatertight = true, int kKind = kAnyKind>
+PB_HD uint32_t intersect_closest(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
+  return traverse<false, kWatertight, kKind>(bvh, o, d, t_max, t_hit);
+}
+template <bool kWatertight = true, int kKind = kAnyKind>
+PB_HD bool occluded(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
+  float t;
+  return traverse<true, kWatertight, kKind>(bvh, o, d, t_max, t) != kNoHit;
+}
+
+// Calls fn(std::integral_constant<int, kind>{}) for the view's kind: picks the kernel
+// compiled for it (host code).
+template <class Fn>
+decltype(auto) with_traversal_kind(TraversalKind kind, Fn&& fn) {
+  switch (kind) {
+    case TraversalKind::Wide: return fn(std::integral_constant<int, int(TraversalKind::Wide)>{});
+    case TraversalKind::AllTriangles: return fn(std::integral_constant<int, int(TraversalKind::AllTriangles)>{});
+    default: return fn(std::integral_constant<int, int(TraversalKind::Binary)>{});
+  }
+}
+
+}  // namespace pb::gpu

@@ -1,0 +1,220 @@
+#pragma once
+// The GPU's wide BVH: up to 8 children a node, their boxes quantised to 8 bits per axis
+// relative to the node's own box (Ylitie, Karras & Laine, "Efficient Incoherent Ray
+// Traversal on GPUs Through Compressed Wide BVHs", HPG 2017). An 80-byte node replaces
+// up to 7 binary 64-byte nodes, so a ray reads about a third of the node bytes and
+// keeps far fewer stack entries. Built on the host by collapsing the binary BVH
+// (gpu/src/wide_bvh_build.cpp); the traversal below is host+device code, so the
+// host-side tests run exactly what the kernels run.
+//
+// Traversal follows the paper: a stack of "node groups" (the base index of a node's inner
+// children + a mask of the ones the ray hit, ordered by the ray's octant so that popping
+// the highest bit takes the child nearest the ray's origin first), the hit leaves'
+// triangles tested as soon as the node is (one bit each in the low 24 bits).
+#include <cstdint>
+#include <cstring>
+
+#include "pathbench/common/hd.h"
+#include "pathbench/common/math.h"
+#include "pathbench/gpu/bvh.h"
+
+// The per-node loops must unroll on the device: their small arrays then live in
+// registers, not in local memory.
+#if defined(__CUDA_ARCH__)
+#define PB_WIDE_UNROLL _Pragma("unroll")
+#else
+#define PB_WIDE_UNROLL
+#endif
+
+namespace pb::gpu {
+
+constexpr uint32_t kWideMaxChildren = 8;
+constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
+constexpr int kWideStackSize = 64;        // one entry per level at most; the builder checks the depth
+
+// One node. Child i's box is p + 2^(e - 127) * q in each axis, rounded outward when
+// built, so it holds the child's real box. meta[i]: 0 for an empty slot; an inner child
+// 0b001'(24 + i); a leaf (count 1..3 triangles from tri_base + offset) the count in unary
+// in the top 3 bits over the 5-bit offset. Inner children are stored contiguously from
+// child_base in slot order (the k-th set bit of imask is child_base + k).
+struct alignas(16) WideNode {
+  float p[3];
+  uint8_t e[3];
+  uint8_t imask;
+  uint32_t child_base;
+  uint32_t tri_base;
+  uint8_t meta[8];
+  uint8_t qlo[3][8];  // [axis][slot]
+  uint8_t qhi[3][8];
+};
+static_assert(sizeof(WideNode) == 80, "WideNode is five 16-byte loads");
+
+struct WideBvhView {
+  const WideNode* nodes;  // node 0 is the root
+  const BvhTriangle* tris;
+  uint32_t num_nodes;
+  uint32_t num_tris;
+};
+
+namespace detail {
+
+PB_HD uint32_t highest_bit(uint32_t v) {  // v != 0
+#if defined(__CUDA_ARCH__)
+  return 31u - uint32_t(__clz(v));
+#else
+  return 31u - uint32_t(__builtin_clz(v));
+#endif
+}
+PB_HD uint32_t lowest_bit(uint32_t v) {  // v != 0
+#if defined(__CUDA_ARCH__)
+  return uint32_t(__ffs(v)) - 1u;
+#else
+  return uint32_t(__builtin_ctz(v));
+#endif
+}
+PB_HD uint32_t popcount(uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return uint32_t(__popc(v));
+#else
+  return uint32_t(__builtin_popcount(v));
+#endif
+}
+PB_HD float exp2_of_byte(uint32_t e) {  // 2^(e - 127) for e in 1..254: a normal float
+  const uint32_t bits = e << 23;
+#if defined(__CUDA_ARCH__)
+  return __uint_as_float(bits);
+#else
+  float f;
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
+#endif
+}
+
+// The node as 20 words: p.xyz, e+imask, child_base, tri_base, meta (2), qlo (6), qhi (6).
+PB_HD void load_wide_node(const WideNode* nodes, uint32_t i, uint32_t (&w)[20]) {
+#if defined(__CUDA_ARCH__)
+  const uint4* p = reinterpret_cast<const uint4*>(nodes + i);
+  PB_WIDE_UNROLL
+  for (int k = 0; k < 5; ++k) {
+    const uint4 v = __ldg(p + k);
+    w[4 * k] = v.x; w[4 * k + 1] = v.y; w[4 * k + 2] = v.z; w[4 * k + 3] = v.w;
+  }
+#else
+  std::memcpy(w, nodes + i, sizeof(WideNode));
+#endif
+}
+
+PB_HD float word_as_float(uint32_t w) {
+#if defined(__CUDA_ARCH__)
+  return __uint_as_float(w);
+#else
+  float f;
+  std::memcpy(&f, &w, sizeof f);
+  return f;
+#endif
+}
+
+// Byte `k` (0..3) of the 32-bit word `w` as a float.
+PB_HD float byte_as_float(uint32_t w, int k) { return float((w >> (8 * k)) & 0xFFu); }
+
+}  // namespace detail
+
+// Closest hit (kAnyHit = false) or any hit, as traverse() in bvh.h: same triangle test,
+// same answer (the triangle with the smallest t; which of two at exactly the same t
+// depends on the order of the tests).
+template <bool kAnyHit, bool kWatertight = true>
+PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
+                             TraversalStats* stats = nullptr) {
+  const WatertightRay wr = make_watertight_ray(o, d);
+  const Vec3f inv = {detail::safe_inverse(d.x), detail::safe_inverse(d.y), detail::safe_inverse(d.z)};
+  const Vec3f oi = {-(o.x * inv.x), -(o.y * inv.y), -(o.z * inv.z)};
+  constexpr float kFarScale = 1.0000004f;  // as bvh.h: slab rounding (Ize 2013)
+  // Octant of the direction, inverted: child slots are numbered by the corner of the
+  // node they lie toward (bit set = + side), so slot s ^ oct_inv == 7 is entered first.
+  const uint32_t oct = (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
+  const uint32_t oct_inv = 7u - oct;
+  // Per axis: which of the two quantised planes is near (the lo plane for d >= 0).
+  const bool neg[3] = {inv.x < 0.0f, inv.y < 0.0f, inv.z < 0.0f};
+  const float inv_a[3] = {inv.x, inv.y, inv.z}, oi_a[3] = {oi.x, oi.y, oi.z};
+
+  struct Group {
+    uint32_t base, hits;  // hits: inner children in bits 24..31 (octant order), imask in 0..7
+  };
+  Group stack[kWideStackSize];
+  int sp = 0;
+  // The root as the only child of a virtual node: popping bit 31 gives slot 7 ^ oct_inv,
+  // and an empty imask makes its index base + 0.
+  Group ng{0u, 0x80000000u};
+  uint32_t hit = kNoHit, hit_slot = 0;
+  float t = t_max;
+  for (;;) {
+    uint32_t tbase = 0, thits = 0;
+    if (ng.hits & 0xFF000000u) {
+      const uint32_t bit = detail::highest_bit(ng.hits & 0xFF000000u);
+      ng.hits &= ~(1u << bit);
+      const uint32_t slot = (bit - 24u) ^ oct_inv;
+      const uint32_t index = ng.base + detail::popcount(ng.hits & 0xFFu & ((1u << slot) - 1u));
+      if (ng.hits & 0xFF000000u) stack[sp++] = ng;
+      uint32_t w[20];
+      detail::load_wide_node(bvh.nodes, index, w);
+      if (stats) ++stats->nodes;
+      const uint32_t e_imask = w[3];
+      const uint32_t imask = e_imask >> 24;
+      float a[3], b[3];
+      PB_WIDE_UNROLL
+      for (int k = 0; k < 3; ++k) {
+        a[k] = detail::exp2_of_byte((e_imask >> (8 * k)) & 0xFFu) * inv_a[k];
+        b[k] = detail::fmadd(detail::word_as_float(w[k]), inv_a[k], oi_a[k]);
+      }
+      uint32_t hitmask = 0;
+      PB_WIDE_UNROLL
+      for (int half = 0; half < 2; ++half) {  // slots 4 * half .. 4 * half + 3
+        const uint32_t meta4 = w[6 + half];
+        uint32_t qn[3], qf[3];
+        PB_WIDE_UNROLL
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t lo = w[8 + 2 * k + half], hi = w[14 + 2 * k + half];
+          qn[k] = neg[k] ? hi : lo;
+          qf[k] = neg[k] ? lo : hi;
+        }
+        PB_WIDE_UNROLL
+        for (int j = 0; j < 4; ++j) {
+          const uint32_t meta = (meta4 >> (8 * j)) & 0xFFu;
+          const float tx0 = detail::fmadd(detail::byte_as_float(qn[0], j), a[0], b[0]);
+          const float ty0 = detail::fmadd(detail::byte_as_float(qn[1], j), a[1], b[1]);
+          const float tz0 = detail::fmadd(detail::byte_as_float(qn[2], j), a[2], b[2]);
+          const float tx1 = detail::fmadd(detail::byte_as_float(qf[0], j), a[0], b[0]);
+          const float ty1 = detail::fmadd(detail::byte_as_float(qf[1], j), a[1], b[1]);
+          const float tz1 = detail::fmadd(detail::byte_as_float(qf[2], j), a[2], b[2]);
+          const float tn = pmax(pmax(tx0, ty0), pmax(tz0, 0.0f));
+          const float tf = pmin(pmin(pmin(tx1, ty1), tz1) * kFarScale, t);
+          if (meta != 0 && tn <= tf) {
+            const uint32_t slot = 4u * half + j;
+            const bool inner = (imask >> slot) & 1u;
+            const uint32_t index = inner ? ((meta & 0x1Fu) ^ oct_inv) : (meta & 0x1Fu);
+            hitmask |= (meta >> 5) << index;
+          }
+        }
+      }
+      ng = {w[4], (hitmask & 0xFF000000u) | imask};
+      tbase = w[5];
+      thits = hitmask & 0x00FFFFFFu;
+    }
+    while (thits) {
+      const uint32_t k = detail::lowest_bit(thits);
+      thits &= thits - 1u;
+      const uint32_t i = tbase + k;
+      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+        t_hit = t;
+        return hit;
+      }
+    }
+    if (!(ng.hits & 0xFF000000u)) {
+      if (sp == 0) break;
+      ng = stack[--sp];
+    }
+  }
+  return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
+}
+
+}  // namespace pb::gpu

@@ -1,0 +1,115 @@
+#include "pathbench/gpu/bvh_layout.h"
+
+#include <fmt/core.h>
+
+#include <charconv>
+#include <chrono>
+#include <cstdlib>
+#include <string>
+
+#include "pathbench/common/errors.h"
+
+namespace pb::gpu {
+
+namespace {
+constexpr struct {
+  GpuBvhLayout layout;
+  const char* name;
+} kNames[] = {{GpuBvhLayout::Auto, "auto"},   {GpuBvhLayout::Binary, "binary"}, {GpuBvhLayout::Wide4, "wide4"},
+              {GpuBvhLayout::Wide8, "wide8"}, {GpuBvhLayout::Brute, "brute"}};
+}  // namespace
+
+const char* to_string(GpuBvhLayout l) {
+  for (const auto& n : kNames)
+    if (n.layout == l) return n.name;
+  return "?";
+}
+
+GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what) {
+  for (const auto& n : kNames)
+    if (name == n.name) return n.layout;
+  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute)", what, name));
+}
+
+GpuBvhOptions GpuBvhOptions::from_env() {
+  GpuBvhOptions o;
+  if (const char* v = std::getenv("PATHBENCH_GPU_BVH"); v && *v) o.layout = parse_gpu_bvh_layout(v);
+  if (const char* v = std::getenv("PATHBENCH_GPU_BRUTE_MAX_TRIS"); v && *v) {
+    const std::string_view s(v);
+    uint32_t n = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), n);
+    if (ec != std::errc() || end != s.data() + s.size() || n > kBruteMaxTrianglesLimit)
+      throw InputError(fmt::format("PATHBENCH_GPU_BRUTE_MAX_TRIS: '{}' is not a triangle count 0..{}", s,
+                                   kBruteMaxTrianglesLimit));
+    o.brute_max_triangles = n;
+  }
+  return o;
+}
+
+GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles) {
+  if (o.layout != GpuBvhLayout::Auto) return o.layout;
+  return triangles <= o.brute_max_triangles ? GpuBvhLayout::Brute : kAutoLayout;
+}
+
+SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SceneBvhHost out;
+  out.layout = resolve_layout(options, scene.triangles.size());
+  if (out.layout == GpuBvhLayout::Brute) {
+    out.all.resize(scene.triangles.size());
+    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+      const Triangle& t = scene.triangles[i];
+      const Vec3f a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
+      BvhTriangle& bt = out.all[i];
+      bt = BvhTriangle{};
+      bt.v0[0] = a.x; bt.v0[1] = a.y; bt.v0[2] = a.z; bt.prim = uint32_t(i);
+      bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
+      bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
+    }
+  } else {
+    const bool wide = out.layout != GpuBvhLayout::Binary;
+    BvhBuildOptions bo;
+    if (wide) bo.max_leaf_size = kWideMaxLeafTris;  // a wide leaf holds up to 3
+    out.binary = build_bvh(scene, bo);
+    out.binary_depth = out.binary.depth;
+    out.binary_leaves = out.binary.leaves;
+    out.binary_sah = out.binary.sah_cost;
+    if (wide) {
+      out.wide = collapse_bvh(out.binary, out.layout == GpuBvhLayout::Wide4 ? 4 : 8);
+      out.binary = BvhHost{};
+    }
+  }
+  out.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+BvhView SceneBvhHost::view() const {
+  BvhView v;
+  switch (layout) {
+    case GpuBvhLayout::Brute:
+      v.kind = TraversalKind::AllTriangles;
+      v.tris = all.data();
+      v.num_tris = uint32_t(all.size());
+      break;
+    case GpuBvhLayout::Wide4:
+    case GpuBvhLayout::Wide8:
+      v.kind = TraversalKind::Wide;
+      v.wide = wide.view();
+      break;
+    default:
+      v.kind = TraversalKind::Binary;
+      v.binary = binary.view();
+  }
+  return v;
+}
+
+uint64_t SceneBvhHost::bytes() const {
+  return binary.bytes() + wide.bytes() + all.size() * sizeof(BvhTriangle);
+}
+uint32_t SceneBvhHost::nodes() const { return uint32_t(binary.nodes.size() + wide.nodes.size()); }
+uint32_t SceneBvhHost::node_bytes() const {
+  if (layout == GpuBvhLayout::Brute) return 0;
+  return layout == GpuBvhLayout::Binary ? uint32_t(sizeof(BvhNode)) : uint32_t(sizeof(WideNode));
+}
+
+}  // namespace pb::gpu
