@@ -177,6 +177,16 @@ int run_render(RenderOptions& o) {
                report.seconds, report.rays_per_second() / 1e6, report.rays.total(), report.paths);
     if (report.discarded_samples) fmt::print(", {} discarded", report.discarded_samples);
     fmt::print(")\n");
+    if (report.extra.contains("ranks")) {  // MPI ranks (run/ranks_report.h)
+      const nlohmann::json& x = report.extra["ranks"];
+      std::string share;
+      for (const auto& [device, part] : x["device_share"].items())
+        share += fmt::format("{}{} {:.1f}%", share.empty() ? "" : ", ", device, 100 * part.get<double>());
+      fmt::print("ranks: {} ({} balance; samples: {}), load balance {:.2f}, parallel efficiency {:.2f}, reduction "
+                 "{:.3f} s\n",
+                 x["count"].get<int>(), x["balance"].get<std::string>(), share, x["load_balance"].get<double>(),
+                 x["parallel_efficiency"].get<double>(), x["reduce_seconds"].get<double>());
+    }
     if (!o.out.empty()) fmt::print("image: {}\n", o.out);
     if (!o.report.empty()) fmt::print("report: {}\n", o.report);
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <string>
 #include <vector>
 
 #include "cli_checks.h"
@@ -12,7 +13,9 @@
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/run/ranks_render.h"
 #include "pathbench/run/run.h"
+#include "pathbench/run/world.h"
 
 namespace pb::app {
 
@@ -112,7 +115,10 @@ int run_reproduce(const ReproduceOptions& o) {
   if (o.spp == 0) throw InputError("--spp: must be at least 1");
   std::vector<Device> devices;
   std::string why_no_gpu;
-  const bool have_gpu = run::gpu_available(&why_no_gpu);
+  // Under mpirun every rank renders a share of every row (run::render_ranks): the rows,
+  // the GPU's presence and the budget's spp are rank 0's, and rank 0 alone writes.
+  run::World& world = run::World::get();
+  const bool have_gpu = world.all(run::gpu_available(&why_no_gpu) ? "gpu" : "")[0] == "gpu";
   if (o.device != "gpu") devices.push_back(Device::Cpu);
   if (o.device == "gpu" && !have_gpu) throw InputError(fmt::format("--device gpu: {}", why_no_gpu));
   if (o.device != "cpu" && have_gpu) devices.push_back(Device::Gpu);
@@ -123,7 +129,8 @@ int run_reproduce(const ReproduceOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   const bool cpu_rows = devices.front() == Device::Cpu;
   // CPU rows other than the image row (pixel, nee) may run at fewer spp.
-  const uint32_t reduced_spp = cpu_rows ? reduced_spp_for_budget(scene, o.spp, o.budget_s, o.threads) : o.spp;
+  const uint32_t reduced_spp = uint32_t(std::stoul(world.all(std::to_string(
+      cpu_rows && world.root() ? reduced_spp_for_budget(scene, o.spp, o.budget_s, o.threads) : o.spp))[0]));
   const uint32_t uniform_spp = o.uniform_spp ? o.uniform_spp : reduced_spp;
   std::vector<RunReport> rows;
   nlohmann::json all = nlohmann::json::array();
@@ -140,10 +147,11 @@ int run_reproduce(const ReproduceOptions& o) {
         Film film(s.width, s.height, false);
         RunReport r;
         try {
-          run::render(scene, s, film, r);
+          if (!run::render_ranks(scene, s, film, r)) continue;  // not rank 0: its share is given
         } catch (const std::exception& e) {
           // The paper's queue may not fit: a row saying so, not a failed run.
           if (strategy != Strategy::PaperQueue) throw;
+          if (!world.root()) continue;  // PeerFailure: rank 0 has the message
           fmt::print(stderr, "reproduce: {} {} {}: {}\n", to_string(dev), to_string(strategy), to_string(sampling),
                      e.what());
           r.settings = s;
@@ -172,6 +180,7 @@ int run_reproduce(const ReproduceOptions& o) {
       }
     }
   }
+  if (!world.root()) return 0;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   write_text_file(dir + "/paper-cornell-report.json", all.dump(2) + "\n");
 

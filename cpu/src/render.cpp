@@ -18,6 +18,11 @@ namespace pb::cpu {
 uint64_t default_paths_in_flight(int threads) { return uint64_t(threads) * 4096; }
 
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report) {
+  render(scene, *make_embree_scene(scene, settings.watertight, settings.embree_layout), settings, film, report);
+}
+
+void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings& settings, Film& film,
+            RunReport& report) {
   if (settings.strategy == Strategy::PaperQueue)
     throw InputError("--strategy paper-queue: the paper's global queue is a GPU strategy; the CPU runs pixel or wavefront");
   if (film.width() != settings.width || film.height() != settings.height)
@@ -29,8 +34,6 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
   const int threads = settings.threads > 0 ? settings.threads : tbb::this_task_arena::max_concurrency();
 
-  const std::unique_ptr<EmbreeScene> embree_scene = make_embree_scene(scene, settings.watertight, settings.embree_layout);
-  const EmbreeScene& embree = *embree_scene;
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
                     settings.traced_samples(), settings.progress);
   // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share).

@@ -12,6 +12,10 @@
 
 namespace pb::run {
 
+struct RankTracer::Cpu {
+  std::unique_ptr<cpu::EmbreeScene> scene;
+};
+
 struct RankTracer::Gpu {
 #if PATHBENCH_HAVE_CUDA
   explicit Gpu(const Scene& s) : scene(s) {}
@@ -22,7 +26,10 @@ struct RankTracer::Gpu {
 RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options)
     : scene_(scene), settings_(settings), options_(options) {
   settings_.validate();
-  if (settings_.device == Device::Gpu) {
+  if (settings_.device == Device::Cpu) {
+    // Built once for every chunk (a million-triangle scene takes Embree a second).
+    cpu_ = std::make_unique<Cpu>(Cpu{cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout)});
+  } else {
     std::string why;
     if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
 #if PATHBENCH_HAVE_CUDA
@@ -40,7 +47,7 @@ void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
   s.progress = false;  // ranks' bars would interleave on one terminal
   RunReport chunk;
   if (s.device == Device::Cpu) {
-    cpu::render(scene_, s, film, chunk);  // Film::add accumulates into the rank's film
+    cpu::render(scene_, *cpu_->scene, s, film, chunk);  // Film::add accumulates into the rank's film
   } else {
 #if PATHBENCH_HAVE_CUDA
     // The device's film comes back whole, replacing the host's: the first chunk lands in

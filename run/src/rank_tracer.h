@@ -1,6 +1,6 @@
 #pragma once
 // One rank's tracer for the rank render (ranks_render.cpp): settings checked and the
-// device's scene built once, then any number of sample chunks traced into one film.
+// device's scene (Embree's, or the GPU's BVH) built once, then any number of sample chunks traced into one film.
 #include <memory>
 
 #include "pathbench/common/film.h"
@@ -28,7 +28,9 @@ class RankTracer {
   RenderSettings settings_;
   RunOptions options_;
   Film scratch_;  // GPU: the device's film comes back whole, so later chunks land here first
-  struct Gpu;
+  struct Cpu;  // the Embree scene
+  struct Gpu;  // the uploaded scene and BVH
+  std::unique_ptr<Cpu> cpu_;
   std::unique_ptr<Gpu> gpu_;
   int chunks_ = 0;
 };

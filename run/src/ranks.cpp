@@ -38,11 +38,13 @@ uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, do
   (void)spp, (void)ranks;
   if (remaining == 0) return 0;
   // Not measured yet: a probe of one sample per pixel (a CPU rank's first chunk must not
-  // outlast a GPU's whole frame). Then 3/4 of what is left, shared by rate: every rank's
-  // chunk ends after about 3/4 of the frame's remaining time, whoever it is, so ranks
-  // finish close together and a fast rank needs few chunks (each GPU call costs a
-  // warm-up frame and a film copy): about log4(spp) of them.
-  const double want = rate > 0 && total_rate > 0 ? std::ceil(0.75 * double(remaining) * rate / total_rate) : 1.0;
+  // outlast a GPU's whole frame). Then a fraction f of what is left, shared by rate: every
+  // rank's chunk ends after about f of the frame's remaining time, whoever it is, so ranks
+  // finish close together. f grows from 3/4 with the rank's share of the rate, so that a
+  // dominant rank (a GPU beside CPUs, whose every call costs a warm-up frame and a film
+  // copy) needs few chunks, and slow ranks take the smaller ones at the end.
+  const double share = rate > 0 && total_rate > 0 ? std::min(1.0, rate / total_rate) : 0.0;
+  const double want = share > 0 ? std::ceil((0.75 + 0.2 * share) * share * double(remaining)) : 1.0;
   return uint32_t(std::min<double>(std::max(want, 1.0), remaining));
 }
 

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <climits>
+#include <cstdio>
+#include <cstdlib>
 
 #include "pathbench/run/world.h"
 
@@ -11,6 +13,11 @@ namespace pb::run {
 World::World() {
   char name[HOST_NAME_MAX + 1] = {};
   if (::gethostname(name, sizeof name - 1) == 0) host_ = name;
+  // Started by mpirun all the same: say so once, rather than render N whole frames silently.
+  if (std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE"))
+    std::fputs("pathbench: warning: started by an MPI launcher, but this build has no MPI (configure with "
+               "-DPATHBENCH_MPI=ON and libopenmpi-dev): every process renders the whole frame on its own\n",
+               stderr);
 }
 
 World& World::get() {

@@ -8,6 +8,7 @@
 # hybrid_no_gpu   --device hybrid where no GPU can run: exit 2, the GPU rank's message
 # killed_rank     rank 1 SIGKILLed mid-render: the run ends within 30 s, non-zero, no image
 # accuracy        `accuracy --quick`: the ranks' reference equals the one-process reference
+# reproduce       `reproduce --device cpu --spp 16`: the ranks' images equal one process's
 # gpu2, hybrid    (CUDA builds; skipped, status 77, without a usable GPU) 2 GPU ranks, and
 #                 --device hybrid (GPU + CPU ranks, dynamic), give the one-GPU image
 # Small frames (64x64): each case takes a few seconds on 2 cores.
@@ -84,6 +85,18 @@ case $case_name in
       cmp -s "$f" "two/${f#one/}" || fail "two/${f#one/} differs from the one-process reference"
     done
     grep -q '"parallel_efficiency"' two/reference-*.json || fail "the reference's report has no ranks section" ;;
+  reproduce)
+    "$pb" reproduce --device cpu --spp 16 --budget 0 --quiet --out-dir one >one.log 2>&1 || { cat one.log >&2; fail "one process failed"; }
+    run -np 2 "$pb" reproduce --device cpu --spp 16 --budget 0 --quiet --out-dir two
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    n=0
+    for f in one/paper-cornell-cpu-*.pfm one/paper-cornell-cpu-*.png; do
+      [ -e "$f" ] || continue
+      cmp -s "$f" "two/${f#one/}" || fail "two/${f#one/} differs from the one-process image"
+      n=$((n + 1))
+    done
+    [ $n -ge 2 ] || fail "no images to compare"
+    grep -q '"parallel_efficiency"' two/paper-cornell-report.json || fail "the rows' reports have no ranks section" ;;
   gpu2|hybrid)
     "$pb" $frame --device gpu --out gpu.pfm 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
     if [ $case_name = gpu2 ]; then run -np 2 "$pb" $frame --device gpu --out x.pfm

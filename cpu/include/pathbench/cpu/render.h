@@ -4,6 +4,7 @@
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
+#include "pathbench/cpu/embree_scene.h"
 
 namespace pb::cpu {
 
@@ -13,6 +14,10 @@ namespace pb::cpu {
 // (scene, settings, peak memory). Throws InputError on settings the CPU tracer cannot
 // run (e.g. the paper-queue strategy).
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report);
+// The same with the Embree scene built once by the caller (make_embree_scene with the
+// settings' watertight and layout), for many renders of one scene: an MPI rank's chunks.
+void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings& settings, Film& film,
+            RunReport& report);
 
 // Default number of paths in flight for the wavefront strategy.
 uint64_t default_paths_in_flight(int threads);
