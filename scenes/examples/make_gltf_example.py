@@ -3,29 +3,13 @@
 scene made by the project, with one pyramid mesh placed by three nodes (TRS and a
 matrix), a metallic and a diffuse material, an emissive quad light, a ground plane
 under a parent node, and a perspective camera."""
-import base64, json, math, struct
+import json, math, sys
 from pathlib import Path
 
-blob, views, accessors = b"", [], []
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
+import gltf_buffers  # noqa: E402
 
-def add(data, target, acc):
-    global blob
-    while len(blob) % 4:
-        blob += b"\0"
-    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
-    blob += data
-    acc["bufferView"] = len(views) - 1
-    accessors.append(acc)
-    return len(accessors) - 1
-
-def mesh(name, points, faces, material):
-    flat = [c for p in points for c in p]
-    pos = add(struct.pack("<%df" % len(flat), *flat), 34962,
-              {"componentType": 5126, "count": len(points), "type": "VEC3",
-               "min": [min(p[i] for p in points) for i in range(3)], "max": [max(p[i] for p in points) for i in range(3)]})
-    idx = [i for f in faces for i in f]
-    ind = add(struct.pack("<%dH" % len(idx), *idx), 34963, {"componentType": 5123, "count": len(idx), "type": "SCALAR"})
-    return {"name": name, "primitives": [{"attributes": {"POSITION": pos}, "indices": ind, "material": material}]}
+buf = gltf_buffers.Buffer()
 
 PYRAMID = [(-0.5, 0, -0.5), (0.5, 0, -0.5), (0.5, 0, 0.5), (-0.5, 0, 0.5), (0, 0.9, 0)]
 PYRAMID_FACES = [(0, 1, 2), (0, 2, 3), (0, 4, 1), (1, 4, 2), (2, 4, 3), (3, 4, 0)]  # outward
@@ -57,9 +41,8 @@ gltf = {
          "emissiveFactor": [1, 0.95, 0.9], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 12}}},
     ],
     "extensionsUsed": ["KHR_materials_emissive_strength"],
-    "meshes": [mesh("pyramid-gold", PYRAMID, PYRAMID_FACES, 0), mesh("pyramid-clay", PYRAMID, PYRAMID_FACES, 1),
-               mesh("ground", QUAD, [(0, 1, 2), (0, 2, 3)], 2), mesh("light", QUAD_DOWN, [(0, 1, 2), (0, 2, 3)], 3)],
-    "bufferViews": views, "accessors": accessors,
+    "meshes": [buf.mesh(PYRAMID, PYRAMID_FACES, 0, "pyramid-gold"), buf.mesh(PYRAMID, PYRAMID_FACES, 1, "pyramid-clay"),
+               buf.mesh(QUAD, [(0, 1, 2), (0, 2, 3)], 2, "ground"), buf.mesh(QUAD_DOWN, [(0, 1, 2), (0, 2, 3)], 3, "light")],
 }
-gltf["buffers"] = [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]
+gltf = buf.finish(gltf)
 (Path(__file__).resolve().parent / "pyramids.gltf").write_text(json.dumps(gltf, indent=1) + "\n")

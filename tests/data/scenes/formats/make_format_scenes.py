@@ -3,10 +3,12 @@
 one scene as JSON (instanced.json, and flattened.json without instancing), glTF (instanced.gltf, .glb), Mitsuba 3 XML
 (instanced.xml), and cube.obj as ASCII and binary PLY. test_scene_formats.cpp checks
 that each loads to the same triangles as its JSON or OBJ twin."""
-import base64, json, math, struct
+import json, math, struct, sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parents[3] / "tools"))
+import gltf_buffers  # noqa: E402
 V = [(-0.5, -0.5, -0.5), (0.5, -0.5, -0.5), (0.5, 0.5, -0.5), (-0.5, 0.5, -0.5),
      (-0.5, -0.5, 0.5), (0.5, -0.5, 0.5), (0.5, 0.5, 0.5), (-0.5, 0.5, 0.5)]
 QUADS = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (3, 7, 6, 2), (0, 4, 7, 3), (1, 2, 6, 5)]  # cube.obj, 0-based
@@ -60,25 +62,7 @@ flat["meshes"] = [{"file": "cube.obj", "material": "blue", "transform": t} for t
 (HERE / "flattened.json").write_text(json.dumps(flat, indent=1) + "\n")
 
 # glTF: one buffer (cube, floor, light positions and indices), embedded as base64.
-tris = TRIS
-blob, views, accessors = b"", [], []
-def add(data, target, acc):
-    global blob
-    while len(blob) % 4:
-        blob += b"\0"
-    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
-    blob += data
-    acc["bufferView"] = len(views) - 1
-    accessors.append(acc)
-    return len(accessors) - 1
-def mesh(points, faces, material):
-    flat = [c for p in points for c in p]
-    pos = add(struct.pack("<%df" % len(flat), *flat), 34962,
-              {"componentType": 5126, "count": len(points), "type": "VEC3",
-               "min": [min(p[i] for p in points) for i in range(3)], "max": [max(p[i] for p in points) for i in range(3)]})
-    idx = [i for f in faces for i in f]
-    ind = add(struct.pack("<%dH" % len(idx), *idx), 34963, {"componentType": 5123, "count": len(idx), "type": "SCALAR"})
-    return {"primitives": [{"attributes": {"POSITION": pos}, "indices": ind, "material": material}]}
+buf = gltf_buffers.Buffer()
 half = math.radians(ROT["angle"]) / 2
 gltf = {
     "asset": {"version": "2.0", "generator": "pathbench make_format_scenes.py"},
@@ -98,10 +82,10 @@ gltf = {
          "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 6}}},
     ],
     "extensionsUsed": ["KHR_materials_emissive_strength"],
-    "meshes": [mesh(V, tris, 0), mesh(FLOOR, [(0, 1, 2), (0, 2, 3)], 1), mesh(LIGHT, [(0, 1, 2), (0, 2, 3)], 2)],
-    "bufferViews": views, "accessors": accessors,
+    "meshes": [buf.mesh(V, TRIS, 0), buf.mesh(FLOOR, [(0, 1, 2), (0, 2, 3)], 1), buf.mesh(LIGHT, [(0, 1, 2), (0, 2, 3)], 2)],
 }
-gltf["buffers"] = [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]
+gltf = buf.finish(gltf)
+blob = buf.blob
 (HERE / "instanced.gltf").write_text(json.dumps(gltf, indent=1) + "\n")
 # The same as a .glb: the JSON chunk, then the buffer as the BIN chunk.
 glb_json = dict(gltf, buffers=[{"byteLength": len(blob)}])
