@@ -65,34 +65,64 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
     const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
     const V3 e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
-    const FV U = emb_dot(emb_cross(e0, v2 + v0), d);
-    const FV V = emb_dot(emb_cross(e1, v0 + v1), d);
-    const FV W = emb_dot(emb_cross(e2, v1 + v2), d);
-    const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
-    const FV m = m_scale * tr.edge;
-    const IV outside = (hi > m) & (lo < -m);
-    if (lane_mask(~outside) == 0) continue;  // (movemask: any() tests lane by lane)
-    // cross(e0, e1): Embree's stable_triangle_normal picks, per component, between it
-    // and cross(e1, e2), equal but for rounding (|difference| << E^2, inside `band`).
-    const V3 ng = emb_cross(e0, e1);
-    FV den = emb_dot(ng, d);
-    den = den + den;
-    FV T = emb_dot(v0, ng);
-    T = T + T;
-    const FV abs_den = abs(den);
-    const FV Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
-    const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
-    // T = 2 dot(v0, Ng): the two computations' Ng differ by rounding relative to E^2, and
-    // the dot by rounding relative to |v0| |Ng|.
-    const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
-    const FV band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
-    const IV grazing = abs_den <= 0x1p-15f * ng1 * d1;        // |den| <= 2 |Ng|_1 |D|_1: 2^-16 of that
-    const IV inside = ((lo > m) | (hi < -m)) & ~grazing;
-    const IV front = Ts > band, behind = Ts < -band;
-    const IV before = Ts < abs_den * tfar_lo - band, beyond = Ts > abs_den * tfar_hi + band;
-    const IV proven = inside & front & before;
-    // den == 0: Embree rejects the triangle outright (a ray in its plane).
-    const IV doubt = ~proven & ~outside & (abs_den != 0.0f) & (grazing | ~(behind | beyond));
+    // The edge functions and the depth, in the order that lets the most triangles go
+    // early: for shadow rays the depth first (every wall of a closed box is crossed
+    // behind the origin or beyond tfar), for closest hits the edges first.
+    struct Edges {
+      IV outside, inside_any;  // inside_any: inside, before the grazing test
+    };
+    auto edges = [&] {
+      const FV U = emb_dot(emb_cross(e0, v2 + v0), d);
+      const FV V = emb_dot(emb_cross(e1, v0 + v1), d);
+      const FV W = emb_dot(emb_cross(e2, v1 + v2), d);
+      const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
+      const FV m = m_scale * tr.edge;
+      return Edges{(hi > m) & (lo < -m), (lo > m) | (hi < -m)};
+    };
+    struct Depth {
+      FV abs_den, Ts, band;
+      IV grazing, front, before, away;
+    };
+    auto depth = [&] {
+      // cross(e0, e1): Embree's stable_triangle_normal picks, per component, between it
+      // and cross(e1, e2), equal but for rounding (|difference| << E^2, inside `band`).
+      const V3 ng = emb_cross(e0, e1);
+      FV den = emb_dot(ng, d);
+      den = den + den;
+      FV T = emb_dot(v0, ng);
+      T = T + T;
+      Depth z;
+      z.abs_den = abs(den);
+      z.Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
+      const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
+      // T = 2 dot(v0, Ng): the two computations' Ng differ by rounding relative to E^2,
+      // and the dot by rounding relative to |v0| |Ng|.
+      const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
+      z.band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
+      z.grazing = z.abs_den <= 0x1p-15f * ng1 * d1;  // |den| <= 2 |Ng|_1 |D|_1: 2^-16 of that
+      z.front = z.Ts > z.band;
+      const IV behind = z.Ts < -z.band;
+      z.before = z.Ts < z.abs_den * tfar_lo - z.band;
+      const IV beyond = z.Ts > z.abs_den * tfar_hi + z.band;
+      // den == 0: Embree rejects the triangle outright (a ray in its plane).
+      z.away = (z.abs_den == 0.0f) | (~z.grazing & (behind | beyond));
+      return z;
+    };
+    Edges ed;
+    Depth z;
+    if (any_hit) {
+      z = depth();
+      if (lane_mask(~z.away) == 0) continue;  // (movemask: any() tests lane by lane)
+      ed = edges();
+    } else {
+      ed = edges();
+      if (lane_mask(~ed.outside) == 0) continue;
+      z = depth();
+    }
+    const IV proven = ed.inside_any & ~z.grazing & z.front & z.before;
+    const IV doubt = ~proven & ~ed.outside & ~z.away;
+    const FV abs_den = z.abs_den, Ts = z.Ts, band = z.band;
+    const IV front = z.front, grazing = z.grazing;
     const FV rcp = 1.0f / abs_den;
     const FV t = Ts * rcp, err = band * rcp + 0x1p-20f * abs(t);
     if (any_hit) {
