@@ -39,14 +39,15 @@ inline V3 emb_cross(V3 a, V3 b) {
   return {fmsub(a.y, b.z, a.z * b.y), fmsub(a.z, b.x, a.x * b.z), fmsub(a.x, b.y, a.y * b.x)};
 }
 struct TinyResult {
-  FV best, best_lo, best_hi;  // nearest proven hit's distance and its error interval
+  FV best, best_err;  // nearest proven hit's distance and its error (0 while there is none)
   FV other_lo;       // lowest bottom of any other proven hit's or doubt's interval
   UV id;             // scene triangle of `best`
 };
 
-// Every triangle of `s` against the rays; `any_hit` (occlusion): only whether a proven
+// Every triangle of `s` against the rays; `AnyHit` (occlusion): only whether a proven
 // hit exists, and stop once every lane has one.
-inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in, bool any_hit) {
+template <bool AnyHit>
+inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in) {
   FV c[6], tfar;
   for (int j = 0; j < 6; ++j) std::memcpy(&c[j], rays[j], sizeof(FV));
   std::memcpy(&tfar, tfar_in, sizeof tfar);
@@ -59,7 +60,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
   const FV inf = splat(__builtin_inff());
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
-  TinyResult r{inf, inf, inf, inf, UV{} + RTC_INVALID_GEOMETRY_ID};
+  TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   for (const TinyScene::Triangle& tr : s.triangles) {
     const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
     const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
@@ -110,7 +111,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     };
     Edges ed;
     Depth z;
-    if (any_hit) {
+    if constexpr (AnyHit) {
       z = depth();
       if (lane_mask(~z.away) == 0) continue;  // (movemask: any() tests lane by lane)
       ed = edges();
@@ -125,7 +126,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     const IV front = z.front, grazing = z.grazing;
     const FV rcp = 1.0f / abs_den;
     const FV t = Ts * rcp, err = band * rcp + 0x1p-20f * abs(t);
-    if (any_hit) {
+    if constexpr (AnyHit) {
       r.best = select(proven, t, r.best);
       r.other_lo = select(doubt, splat(0.0f), r.other_lo);
       if (lane_mask(r.best == inf) == 0) break;  // every ray blocked: doubts no longer matter
@@ -134,25 +135,24 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     // A doubt's distance counts only where it is known (in front, not grazing); else 0.
     const FV doubt_lo = select(front & ~grazing, t - err, splat(0.0f));
     const IV nearer = proven & (t < r.best);
-    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best_lo, t - err)), r.other_lo);
+    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best - r.best_err, t - err)), r.other_lo);
     r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
     r.best = select(nearer, t, r.best);
-    r.best_lo = select(nearer, t - err, r.best_lo);
-    r.best_hi = select(nearer, t + err, r.best_hi);
+    r.best_err = select(nearer, err, r.best_err);
     r.id = nearer ? UV{} + tr.triangle : r.id;
   }
   return r;
 }
 
 inline uint32_t tiny_closest(const TinyScene& s, const float* const* rays, const float* tfar, uint32_t* triangle) {
-  const TinyResult r = tiny_test(s, rays, tfar, false);
-  const IV unsure = (r.other_lo < splat(__builtin_inff())) & (r.other_lo <= r.best_hi);
+  const TinyResult r = tiny_test<false>(s, rays, tfar);
+  const IV unsure = (r.other_lo < splat(__builtin_inff())) & (r.other_lo <= r.best + r.best_err);
   std::memcpy(triangle, &r.id, sizeof r.id);
   return lane_mask(unsure);
 }
 
 inline uint32_t tiny_occluded(const TinyScene& s, const float* const* rays, const float* tfar, bool* blocked) {
-  const TinyResult r = tiny_test(s, rays, tfar, true);
+  const TinyResult r = tiny_test<true>(s, rays, tfar);
   const FV inf = splat(__builtin_inff());
   const IV hit = r.best < inf;
   for (int i = 0; i < kLanes; ++i) blocked[i] = hit[i] != 0;
