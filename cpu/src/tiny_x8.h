@@ -38,6 +38,17 @@ inline FV emb_dot(V3 a, V3 b) { return fmadd(a.x, b.x, fmadd(a.y, b.y, a.z * b.z
 inline V3 emb_cross(V3 a, V3 b) {
   return {fmsub(a.y, b.z, a.z * b.y), fmsub(a.z, b.x, a.x * b.z), fmsub(a.x, b.y, a.y * b.x)};
 }
+// Embree's stable_triangle_normal(a, b, c) (common/math/vec3.h): per component, the
+// cross product of the pair whose subtracted product is smaller.
+inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
+  const FV ab_x = a.z * b.y, ab_y = a.x * b.z, ab_z = a.y * b.x;
+  const FV bc_x = b.z * c.y, bc_y = b.x * c.z, bc_z = b.y * c.x;
+  const V3 cab{fmsub(a.y, b.z, ab_x), fmsub(a.z, b.x, ab_y), fmsub(a.x, b.y, ab_z)};
+  const V3 cbc{fmsub(b.y, c.z, bc_x), fmsub(b.z, c.x, bc_y), fmsub(b.x, c.y, bc_z)};
+  return {select(abs(ab_x) < abs(bc_x), cab.x, cbc.x), select(abs(ab_y) < abs(bc_y), cab.y, cbc.y),
+          select(abs(ab_z) < abs(bc_z), cab.z, cbc.z)};
+}
+
 struct TinyResult {
   FV best, best_err;  // nearest proven hit's distance and its error (0 while there is none)
   FV other_lo;       // lowest bottom of any other proven hit's or doubt's interval
@@ -60,6 +71,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
   const FV inf = splat(__builtin_inff());
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
+  const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   for (const TinyScene::Triangle& tr : s.triangles) {
     const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
@@ -81,13 +93,11 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
       return Edges{(hi > m) & (lo < -m), (lo > m) | (hi < -m)};
     };
     struct Depth {
-      FV abs_den, Ts, band;
+      FV abs_den, Ts, band, den_band;
       IV grazing, front, before, away;
     };
     auto depth = [&] {
-      // cross(e0, e1): Embree's stable_triangle_normal picks, per component, between it
-      // and cross(e1, e2), equal but for rounding (|difference| << E^2, inside `band`).
-      const V3 ng = emb_cross(e0, e1);
+      const V3 ng = emb_stable_normal(e0, e1, e2);
       FV den = emb_dot(ng, d);
       den = den + den;
       FV T = emb_dot(v0, ng);
@@ -95,16 +105,20 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
       Depth z;
       z.abs_den = abs(den);
       z.Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
+      // Same inputs, same operations as Embree 3.13's source: the same T and den. The
+      // bands are slack for rounding-order differences all the same: in the dots
+      // (relative to |v0| |Ng| for T, |Ng| |D| for den) and, for T, a normal that picked
+      // the other cross product (relative to E^2).
       const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
-      // T = 2 dot(v0, Ng): the two computations' Ng differ by rounding relative to E^2,
-      // and the dot by rounding relative to |v0| |Ng|.
       const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
       z.band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
-      z.grazing = z.abs_den <= 0x1p-15f * ng1 * d1;  // |den| <= 2 |Ng|_1 |D|_1: 2^-16 of that
+      z.den_band = 0x1p-20f * ng1 * d1;
+      z.grazing = z.abs_den <= 32.0f * z.den_band;  // den's sign and size in doubt
       z.front = z.Ts > z.band;
       const IV behind = z.Ts < -z.band;
-      z.before = z.Ts < z.abs_den * tfar_lo - z.band;
-      const IV beyond = z.Ts > z.abs_den * tfar_hi + z.band;
+      const FV tfar_slack = z.band + z.den_band * tfar_finite;
+      z.before = z.Ts < z.abs_den * tfar_lo - tfar_slack;
+      const IV beyond = z.Ts > z.abs_den * tfar_hi + tfar_slack;
       // den == 0: Embree rejects the triangle outright (a ray in its plane).
       z.away = (z.abs_den == 0.0f) | (~z.grazing & (behind | beyond));
       return z;
@@ -125,7 +139,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     const FV abs_den = z.abs_den, Ts = z.Ts, band = z.band;
     const IV front = z.front, grazing = z.grazing;
     const FV rcp = 1.0f / abs_den;
-    const FV t = Ts * rcp, err = band * rcp + 0x1p-20f * abs(t);
+    const FV t = Ts * rcp, err = (band + abs(t) * z.den_band) * rcp + 0x1p-20f * abs(t);
     if constexpr (AnyHit) {
       r.best = select(proven, t, r.best);
       r.other_lo = select(doubt, splat(0.0f), r.other_lo);
