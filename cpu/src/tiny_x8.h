@@ -38,15 +38,27 @@ inline FV emb_dot(V3 a, V3 b) { return fmadd(a.x, b.x, fmadd(a.y, b.y, a.z * b.z
 inline V3 emb_cross(V3 a, V3 b) {
   return {fmsub(a.y, b.z, a.z * b.y), fmsub(a.z, b.x, a.x * b.z), fmsub(a.x, b.y, a.y * b.x)};
 }
+// Embree's stable_triangle_normal(a, b, c) (common/math/vec3.h): per component, the
+// cross product of the pair whose subtracted product is smaller.
+inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
+  const FV ab_x = a.z * b.y, ab_y = a.x * b.z, ab_z = a.y * b.x;
+  const FV bc_x = b.z * c.y, bc_y = b.x * c.z, bc_z = b.y * c.x;
+  const V3 cab{fmsub(a.y, b.z, ab_x), fmsub(a.z, b.x, ab_y), fmsub(a.x, b.y, ab_z)};
+  const V3 cbc{fmsub(b.y, c.z, bc_x), fmsub(b.z, c.x, bc_y), fmsub(b.x, c.y, bc_z)};
+  return {select(abs(ab_x) < abs(bc_x), cab.x, cbc.x), select(abs(ab_y) < abs(bc_y), cab.y, cbc.y),
+          select(abs(ab_z) < abs(bc_z), cab.z, cbc.z)};
+}
+
 struct TinyResult {
-  FV best, best_lo, best_hi;  // nearest proven hit's distance and its error interval
+  FV best, best_err;  // nearest proven hit's distance and its error (0 while there is none)
   FV other_lo;       // lowest bottom of any other proven hit's or doubt's interval
   UV id;             // scene triangle of `best`
 };
 
-// Every triangle of `s` against the rays; `any_hit` (occlusion): only whether a proven
+// Every triangle of `s` against the rays; `AnyHit` (occlusion): only whether a proven
 // hit exists, and stop once every lane has one.
-inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in, bool any_hit) {
+template <bool AnyHit>
+inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in) {
   FV c[6], tfar;
   for (int j = 0; j < 6; ++j) std::memcpy(&c[j], rays[j], sizeof(FV));
   std::memcpy(&tfar, tfar_in, sizeof tfar);
@@ -59,43 +71,76 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
   const FV inf = splat(__builtin_inff());
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
-  TinyResult r{inf, inf, inf, inf, UV{} + RTC_INVALID_GEOMETRY_ID};
+  const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
+  TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   for (const TinyScene::Triangle& tr : s.triangles) {
     const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
     const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
     const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
     const V3 e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
-    const FV U = emb_dot(emb_cross(e0, v2 + v0), d);
-    const FV V = emb_dot(emb_cross(e1, v0 + v1), d);
-    const FV W = emb_dot(emb_cross(e2, v1 + v2), d);
-    const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
-    const FV m = m_scale * tr.edge;
-    const IV outside = (hi > m) & (lo < -m);
-    if (lane_mask(~outside) == 0) continue;  // (movemask: any() tests lane by lane)
-    // cross(e0, e1): Embree's stable_triangle_normal picks, per component, between it
-    // and cross(e1, e2), equal but for rounding (|difference| << E^2, inside `band`).
-    const V3 ng = emb_cross(e0, e1);
-    FV den = emb_dot(ng, d);
-    den = den + den;
-    FV T = emb_dot(v0, ng);
-    T = T + T;
-    const FV abs_den = abs(den);
-    const FV Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
-    const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
-    // T = 2 dot(v0, Ng): the two computations' Ng differ by rounding relative to E^2, and
-    // the dot by rounding relative to |v0| |Ng|.
-    const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
-    const FV band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
-    const IV grazing = abs_den <= 0x1p-15f * ng1 * d1;        // |den| <= 2 |Ng|_1 |D|_1: 2^-16 of that
-    const IV inside = ((lo > m) | (hi < -m)) & ~grazing;
-    const IV front = Ts > band, behind = Ts < -band;
-    const IV before = Ts < abs_den * tfar_lo - band, beyond = Ts > abs_den * tfar_hi + band;
-    const IV proven = inside & front & before;
-    // den == 0: Embree rejects the triangle outright (a ray in its plane).
-    const IV doubt = ~proven & ~outside & (abs_den != 0.0f) & (grazing | ~(behind | beyond));
+    // The edge functions and the depth, in the order that lets the most triangles go
+    // early: for shadow rays the depth first (every wall of a closed box is crossed
+    // behind the origin or beyond tfar), for closest hits the edges first.
+    struct Edges {
+      IV outside, inside_any;  // inside_any: inside, before the grazing test
+    };
+    auto edges = [&] {
+      const FV U = emb_dot(emb_cross(e0, v2 + v0), d);
+      const FV V = emb_dot(emb_cross(e1, v0 + v1), d);
+      const FV W = emb_dot(emb_cross(e2, v1 + v2), d);
+      const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
+      const FV m = m_scale * tr.edge;
+      return Edges{(hi > m) & (lo < -m), (lo > m) | (hi < -m)};
+    };
+    struct Depth {
+      FV abs_den, Ts, band, den_band;
+      IV grazing, front, before, away;
+    };
+    auto depth = [&] {
+      const V3 ng = emb_stable_normal(e0, e1, e2);
+      FV den = emb_dot(ng, d);
+      den = den + den;
+      FV T = emb_dot(v0, ng);
+      T = T + T;
+      Depth z;
+      z.abs_den = abs(den);
+      z.Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
+      // Same inputs, same operations as Embree 3.13's source: the same T and den. The
+      // bands are slack for rounding-order differences all the same: in the dots
+      // (relative to |v0| |Ng| for T, |Ng| |D| for den) and, for T, a normal that picked
+      // the other cross product (relative to E^2).
+      const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
+      const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
+      z.band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
+      z.den_band = 0x1p-20f * ng1 * d1;
+      z.grazing = z.abs_den <= 32.0f * z.den_band;  // den's sign and size in doubt
+      z.front = z.Ts > z.band;
+      const IV behind = z.Ts < -z.band;
+      const FV tfar_slack = z.band + z.den_band * tfar_finite;
+      z.before = z.Ts < z.abs_den * tfar_lo - tfar_slack;
+      const IV beyond = z.Ts > z.abs_den * tfar_hi + tfar_slack;
+      // den == 0: Embree rejects the triangle outright (a ray in its plane).
+      z.away = (z.abs_den == 0.0f) | (~z.grazing & (behind | beyond));
+      return z;
+    };
+    Edges ed;
+    Depth z;
+    if constexpr (AnyHit) {
+      z = depth();
+      if (lane_mask(~z.away) == 0) continue;  // (movemask: any() tests lane by lane)
+      ed = edges();
+    } else {
+      ed = edges();
+      if (lane_mask(~ed.outside) == 0) continue;
+      z = depth();
+    }
+    const IV proven = ed.inside_any & ~z.grazing & z.front & z.before;
+    const IV doubt = ~proven & ~ed.outside & ~z.away;
+    const FV abs_den = z.abs_den, Ts = z.Ts, band = z.band;
+    const IV front = z.front, grazing = z.grazing;
     const FV rcp = 1.0f / abs_den;
-    const FV t = Ts * rcp, err = band * rcp + 0x1p-20f * abs(t);
-    if (any_hit) {
+    const FV t = Ts * rcp, err = (band + abs(t) * z.den_band) * rcp + 0x1p-20f * abs(t);
+    if constexpr (AnyHit) {
       r.best = select(proven, t, r.best);
       r.other_lo = select(doubt, splat(0.0f), r.other_lo);
       if (lane_mask(r.best == inf) == 0) break;  // every ray blocked: doubts no longer matter
@@ -104,25 +149,24 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     // A doubt's distance counts only where it is known (in front, not grazing); else 0.
     const FV doubt_lo = select(front & ~grazing, t - err, splat(0.0f));
     const IV nearer = proven & (t < r.best);
-    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best_lo, t - err)), r.other_lo);
+    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best - r.best_err, t - err)), r.other_lo);
     r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
     r.best = select(nearer, t, r.best);
-    r.best_lo = select(nearer, t - err, r.best_lo);
-    r.best_hi = select(nearer, t + err, r.best_hi);
+    r.best_err = select(nearer, err, r.best_err);
     r.id = nearer ? UV{} + tr.triangle : r.id;
   }
   return r;
 }
 
 inline uint32_t tiny_closest(const TinyScene& s, const float* const* rays, const float* tfar, uint32_t* triangle) {
-  const TinyResult r = tiny_test(s, rays, tfar, false);
-  const IV unsure = (r.other_lo < splat(__builtin_inff())) & (r.other_lo <= r.best_hi);
+  const TinyResult r = tiny_test<false>(s, rays, tfar);
+  const IV unsure = (r.other_lo < splat(__builtin_inff())) & (r.other_lo <= r.best + r.best_err);
   std::memcpy(triangle, &r.id, sizeof r.id);
   return lane_mask(unsure);
 }
 
 inline uint32_t tiny_occluded(const TinyScene& s, const float* const* rays, const float* tfar, bool* blocked) {
-  const TinyResult r = tiny_test(s, rays, tfar, true);
+  const TinyResult r = tiny_test<true>(s, rays, tfar);
   const FV inf = splat(__builtin_inff());
   const IV hit = r.best < inf;
   for (int i = 0; i < kLanes; ++i) blocked[i] = hit[i] != 0;
