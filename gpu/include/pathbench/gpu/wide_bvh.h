@@ -126,9 +126,8 @@ template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                              TraversalStats* stats = nullptr) {
   const WatertightRay wr = make_watertight_ray(o, d);
-  const Vec3f inv = {detail::safe_inverse(d.x), detail::safe_inverse(d.y), detail::safe_inverse(d.z)};
-  const Vec3f oi = {-(o.x * inv.x), -(o.y * inv.y), -(o.z * inv.z)};
-  constexpr float kFarScale = 1.0000004f;  // as bvh.h: slab rounding (Ize 2013)
+  const auto [inv, oi] = detail::make_slab_ray(o, d);
+  using detail::kFarScale;
   // Octant of the direction, inverted: child slots are numbered by the corner of the
   // node they lie toward (bit set = + side), so slot s ^ oct_inv == 7 is entered first.
   const uint32_t oct = (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
