@@ -185,15 +185,10 @@ INSTANTIATE_TEST_SUITE_P(
 // an edge ray, where Woop's t orders two grazed triangles by the order of the tests);
 // where both find the same triangle, the same t bit for bit (the same watertight test
 // and plane_distance); the same any-hit answer on every segment.
-class LayoutsAgree : public ::testing::TestWithParam<SceneCase> {};
-
-TEST_P(LayoutsAgree, SameHitsAsTheBinaryBvh) {
-  bool ok;
-  const Scene scene = load_or_skip(GetParam().name, ok);
-  if (!ok) GTEST_SKIP() << "scene " << GetParam().name << " is not built in yet";
+void expect_same_hits_as_binary(const Scene& scene, GpuBvhLayout layout, const std::string& label) {
   GpuBvhOptions o;
   const SceneBvhHost binary = build_scene_bvh(scene, o);
-  o.layout = GetParam().layout;
+  o.layout = layout;
   const SceneBvhHost other = build_scene_bvh(scene, o);
   const Vec3f ext = scene.bounds_max - scene.bounds_min;
   const Vec3f lo = scene.bounds_min + ext * 0.02f, hi = scene.bounds_max - ext * 0.02f;
@@ -225,17 +220,38 @@ TEST_P(LayoutsAgree, SameHitsAsTheBinaryBvh) {
   std::printf("[ INFO     ] %s %s vs binary: %zu rays, %zu hits; random: %zu other triangles (%zu not ties); edges: "
               "%zu other triangles (%zu not ties, %zu at the aimed-at edge); %zu t differ, %zu occlusion answers "
               "differ\n",
-              GetParam().name, to_string(GetParam().layout), rays, hits, on_random.prim_mismatch,
+              label.c_str(), to_string(layout), rays, hits, on_random.prim_mismatch,
               on_random.prim_mismatch_not_tie, on_edges.prim_mismatch, on_edges.prim_mismatch_not_tie,
               on_edges.at_target_edge, t_differs, occlusion_differs);
-  EXPECT_GT(hits, rays / 2);
+  EXPECT_GT(hits, rays / 2) << label;
   for (const Agreement* a : {&on_random, &on_edges}) {
     EXPECT_EQ(a->hit_miss_mismatch, 0u) << a->first_problem;
     EXPECT_EQ(a->prim_mismatch_not_tie, 0u) << a->first_problem;
     EXPECT_EQ(a->t_mismatch, 0u) << a->first_problem;
   }
-  EXPECT_EQ(t_differs, 0u);
-  EXPECT_EQ(occlusion_differs, 0u);
+  EXPECT_EQ(t_differs, 0u) << label;
+  EXPECT_EQ(occlusion_differs, 0u) << label;
+}
+
+class LayoutsAgree : public ::testing::TestWithParam<SceneCase> {};
+
+TEST_P(LayoutsAgree, SameHitsAsTheBinaryBvh) {
+  bool ok;
+  const Scene scene = load_or_skip(GetParam().name, ok);
+  if (!ok) GTEST_SKIP() << "scene " << GetParam().name << " is not built in yet";
+  expect_same_hits_as_binary(scene, GetParam().layout, GetParam().name);
+}
+
+// The quantised boxes at the extremes of scale: a scene ten thousand times smaller and
+// larger than the box's metres (the boxes' pad and steps follow the scene's size).
+TEST(LayoutsAgreeScaled, TinyAndHugeScenes) {
+  for (float scale : {1e-4f, 1e4f}) {
+    Scene scene = load_scene("paper-cornell-ico:2");
+    for (Vec3f& p : scene.positions) p = p * scale + Vec3f{0.5f, -0.25f, 0.125f} * scale;
+    scene.finalize();
+    for (GpuBvhLayout l : {GpuBvhLayout::Wide8, GpuBvhLayout::Wide4, GpuBvhLayout::Brute})
+      expect_same_hits_as_binary(scene, l, "paper-cornell-ico:2 x " + std::to_string(scale));
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Layouts, LayoutsAgree,

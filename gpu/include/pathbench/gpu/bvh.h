@@ -146,6 +146,18 @@ PB_HD uint32_t finish_closest(const BvhTriangle* tris, const Vec3f& o, const Vec
   return hit;
 }
 
+// The slab test's per-ray constants: t of the plane x = X is fmadd(X, inv.x, oi.x).
+struct SlabRay {
+  Vec3f inv, oi;
+};
+PB_HD SlabRay make_slab_ray(const Vec3f& o, const Vec3f& d) {
+  const Vec3f inv = {safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z)};
+  return {inv, {-(o.x * inv.x), -(o.y * inv.y), -(o.z * inv.z)}};
+}
+// Slab distances carry a few roundings: widen the far end (Ize 2013, 1 + 2 gamma(3));
+// the builders also pad every box by a few ulps of the scene's scale.
+constexpr float kFarScale = 1.0000004f;
+
 }  // namespace detail
 
 // Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
@@ -156,11 +168,8 @@ template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
   const WatertightRay wr = make_watertight_ray(o, d);
-  const Vec3f inv = {detail::safe_inverse(d.x), detail::safe_inverse(d.y), detail::safe_inverse(d.z)};
-  const Vec3f oi = {-(o.x * inv.x), -(o.y * inv.y), -(o.z * inv.z)};
-  // Slab distances carry a few roundings: widen the far end (Ize 2013, 1 + 2 gamma(3));
-  // the builder also pads every box by a few ulps of the scene's scale.
-  constexpr float kFarScale = 1.0000004f;
+  const auto [inv, oi] = detail::make_slab_ray(o, d);
+  using detail::kFarScale;
   uint32_t stack[kTraversalStackSize];
   int sp = 0;
   uint32_t ref = 0;

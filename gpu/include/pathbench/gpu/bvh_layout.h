@@ -21,9 +21,11 @@ namespace pb::gpu {
 enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4 };
 
 // Defaults of `auto`, to be set from the device measurements (gpu/NOTES.md,
-// "Traversal layouts"; gpu/bench_layouts.sh measures them).
+// "Traversal layouts"; `gpu/run_on_device.sh layouts` measures them). Until then, by
+// instruction counts: one wide8 node holds a scene of up to 24 triangles, and a shadow
+// ray through the empty box tests none of them there but every one under brute force.
 constexpr GpuBvhLayout kAutoLayout = GpuBvhLayout::Wide8;
-constexpr uint32_t kDefaultBruteMaxTriangles = 32;
+constexpr uint32_t kDefaultBruteMaxTriangles = 8;
 constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute force is never the answer
 
 struct GpuBvhOptions {
