@@ -1,5 +1,7 @@
 #include "pathbench/run/ranks_render.h"
 
+#include "pathbench/run/film_hash.h"
+
 #include <sched.h>
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <fmt/core.h>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/run/film_hash.h"
 #include "pathbench/run/ranks_report.h"
 #include "pathbench/run/run_context.h"
 #include "pathbench/run/world.h"
@@ -202,6 +205,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     merge_ranks(report, ranks, frame_seconds, reduce_seconds, balance == Balance::Dynamic ? "dynamic" : "static");
     if (balance == Balance::Dynamic) report.extra["ranks"]["chunks_granted"] = granted;
     check_discarded(scene, settings, report);
+    report.extra["film_hash"] = film_hash(film);  // the reduced film's: the same as one process's
   });
   return w.root();
 }

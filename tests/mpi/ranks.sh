@@ -26,7 +26,8 @@ mpi="$mpiexec --oversubscribe --bind-to none"
 base="render --quiet --width 64 --height 64 --bounces 2"
 frame="$base --spp 24"
 fail() { echo "ranks.sh $case_name: $*" >&2; exit 1; }
-one() { "$pb" $frame --threads 1 --out one.pfm || fail "one-process render failed"; }
+one() { "$pb" $frame --threads 1 --out one.pfm --report one.json || fail "one-process render failed"; }
+film_hash() { grep -o '"film_hash": "[^"]*"' "$1"; }
 same() { cmp -s one.pfm "$1" || fail "$1 differs from the one-process image"; }
 # Runs mpirun, keeps its stderr in err.txt and its status in $status, bounded by 60 s.
 run() {
@@ -51,6 +52,8 @@ case $case_name in
       same $balance.pfm
       grep -q "\"count\": $n" $balance.json || fail "the report has no ranks section of $n ranks"
       grep -q '"parallel_efficiency"' $balance.json || fail "the report has no parallel efficiency"
+      [ -n "$(film_hash one.json)" ] && [ "$(film_hash one.json)" = "$(film_hash $balance.json)" ] ||
+        fail "film_hash of $n ranks ($(film_hash $balance.json)) is not one process's ($(film_hash one.json))"
     done ;;
   mpmd_threads)
     one
