@@ -202,10 +202,11 @@ TEST_P(TinyIsa, SameAnswersAsEmbree) {
 TEST(TinyScene, OnlyForTinyScenes) {
   const Scene big = load_scene("paper-cornell-ico:1");  // 94 triangles
   const auto embree = cpu::make_embree_scene(big, true, EmbreeLayout::Triangles);
-  EXPECT_EQ(cpu::TinyScene::build(*embree, big.view()), nullptr);
+  EXPECT_EQ(cpu::TinyScene::build(*embree, big.view(), 64), nullptr);
   const Scene box = load_scene("paper-cornell");
   const auto quads = cpu::make_embree_scene(box, true, EmbreeLayout::Quads);
-  const auto t = cpu::TinyScene::build(*quads, box.view());
+  EXPECT_EQ(cpu::TinyScene::build(*quads, box.view(), 13), nullptr);  // 14 halves
+  const auto t = cpu::TinyScene::build(*quads, box.view(), 14);
   ASSERT_NE(t, nullptr);
   EXPECT_EQ(t->triangles.size(), box.triangles.size());  // every quad's two halves
 }
