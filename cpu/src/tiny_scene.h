@@ -30,9 +30,10 @@
 namespace pb::cpu {
 
 struct TinyScene {
-  // Above this many triangles (as Embree sees them) Embree's BVH is cheaper than testing
-  // them all (measured: cpu/NOTES.md).
-  static constexpr size_t kMaxTriangles = 32;
+  // Above 3 triangles per lane (as Embree sees them: 24 with AVX2, 48 with AVX-512)
+  // Embree's BVH is cheaper than testing them all (AVX2 measured between 14 and 34
+  // triangles; AVX-512, whose test costs half per ray, estimated: cpu/NOTES.md).
+  static constexpr int kTrianglesPerLane = 3;
   struct Triangle {
     float p[9];         // vertices v0, v1, v2 in Embree's order
     uint32_t triangle;  // the scene triangle
@@ -41,11 +42,12 @@ struct TinyScene {
   std::vector<Triangle> triangles;
   float lo[3], hi[3];  // bounds of every vertex
 
-  // The table for the Embree scene `e` of `s`, or null where the scene is too large.
+  // The table for the Embree scene `e` of `s`, or null where it has more than
+  // `max_triangles`.
   // Quads are split as Embree splits them: (v0, v1, v3), then (v2, v3, v1); the empty
   // second half of a lone triangle's quad (a, b, c, c) is left out (Embree never hits it:
   // its normal is zero).
-  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s) {
+  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s, size_t max_triangles) {
     auto t = std::make_unique<TinyScene>();
     auto add = [&](uint32_t a, uint32_t b, uint32_t c, uint32_t tri) {
       Triangle r;
@@ -67,7 +69,7 @@ struct TinyScene {
     } else {
       for (uint32_t i = 0; i < s.num_triangles; ++i) add(s.triangles[i].v[0], s.triangles[i].v[1], s.triangles[i].v[2], i);
     }
-    if (t->triangles.empty() || t->triangles.size() > kMaxTriangles) return nullptr;
+    if (t->triangles.empty() || t->triangles.size() > max_triangles) return nullptr;
     for (int j = 0; j < 3; ++j) {
       t->lo[j] = t->hi[j] = t->triangles[0].p[j];
       for (const Triangle& r : t->triangles)
@@ -81,10 +83,11 @@ struct TinyScene {
 };
 
 // The tiny test where it applies: batched kernels `k` (a vector ISA; AVX2 needs FMA too,
-// as Embree's AVX2 kernels do) and a scene of at most kMaxTriangles; otherwise null.
+// as Embree's AVX2 kernels do) and a scene of at most kTrianglesPerLane per lane;
+// otherwise null.
 inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const SceneView& s, const BatchKernels* k) {
   if (!k || !__builtin_cpu_supports("fma")) return nullptr;
-  return TinyScene::build(e, s);
+  return TinyScene::build(e, s, size_t(TinyScene::kTrianglesPerLane * k->lanes));
 }
 
 // The closest hits of packet `p` (lanes [0, n) valid; W = k.lanes; tfar already set):

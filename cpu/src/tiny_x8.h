@@ -2,25 +2,27 @@
 // simd8.h, under a target that adds FMA.) The tiny-scene test (tiny_scene.h): kLanes rays
 // against every triangle of a TinyScene, lanes = rays.
 //
-// Per triangle it evaluates Embree 3's robust Pluecker test in Embree's order of
-// operations (vertices relative to the ray origin, edge functions U, V, W as
-// dot(cross(e, v + v'), D) with FMA, den and T doubled; the normal as cross(e0, e1)),
-// then decides with margins instead of Embree's exact comparisons:
+// Per triangle it evaluates Embree 3's robust Pluecker test operation for operation
+// (vertices relative to the ray origin, edges, edge functions U, V, W as
+// dot(cross(e, v + v'), D) with FMA as Embree's madd / msub, the normal by
+// stable_triangle_normal, den and T doubled), then decides with margins instead of
+// Embree's exact comparisons:
 //   inside  all of U, V, W beyond +-m with one sign     outside  some beyond +m, some beyond -m
 //   front   T (sign of den applied) > band               behind   < -band
-//   before  t < tfar (1 - 2^-20) - err                    beyond   t > tfar (1 + 2^-20) + err
-// A candidate that is inside, front and before is a proven hit: Embree's test accepts it
-// too. One that is outside, behind or beyond is proven irrelevant. Anything else (near an
-// edge, near the origin's own surface, near tfar) is a doubt at distance t (0 when the
-// depth is in doubt). A ray is unsure when a doubt or a second proven hit lies within a
-// relative 2^-14 of its nearest proven hit (or it has doubts and no proven hit): Embree
-// decides those (tiny_scene.h). m and band scale with the worst-case size of the terms:
-// Both computations start from the same rounded vertices (v = p - o, e = v - v', v + v'
-// are single IEEE operations in either), so they differ only in how the products are
-// rounded: m = 2^-16 E M |D|_1 (E: this triangle's largest edge component, M: a bound on
-// |vertex - origin| over the scene), band = 2^-20 |v0|_inf (|Ng|_1 + 3 E^2), t's error
-// band / |den| + 2^-20 t.
-// cpu/NOTES.md derives them.
+//   before  t < tfar (1 - 2^-20) - slack                 beyond   t > tfar (1 + 2^-20) + slack
+//   grazing |den| within 32x its rounding slack (its sign and size in doubt)
+// A candidate inside, front, before and not grazing is a proven hit: Embree's test accepts
+// it too. One outside, or (not grazing) behind or beyond, is proven irrelevant. Anything
+// else (near an edge, near the origin's own surface, near tfar) is a doubt at distance
+// t - err (0 when its depth is in doubt). A ray is unsure when a doubt or a second proven
+// hit reaches into its nearest proven hit's error interval (or it has doubts and no proven
+// hit): Embree decides those (tiny_scene.h). Both computations start from the same
+// rounded values (v = p - o, e = v - v', v + v' are single IEEE operations in either) and
+// continue with the same operations, so the margins are slack for rounding-order
+// differences: m = 2^-16 E M |D|_1 (E: this triangle's largest edge component, M: a bound
+// on |vertex - origin| over the scene), T's band 2^-20 |v0|_inf (|Ng|_1 + 3 E^2), den's
+// 2^-20 |Ng|_1 |D|_1, t's error (band + t den band) / |den| + 2^-20 t (Embree's rcp).
+// cpu/NOTES.md gives the argument.
 namespace pb::cpu::PB_SIMD_NS {
 
 #if PB_SIMD_LANES == 16
