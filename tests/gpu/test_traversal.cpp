@@ -321,6 +321,9 @@ TEST(Bvh, EmptySceneMissesEverything) {
 // The layout choice: auto takes brute force up to the threshold, else the wide BVH; the
 // environment's names are checked, and a bad one is an InputError naming the variable.
 TEST(BvhLayout, AutoAndNames) {
+  // The default, as measured on an H100: the binary BVH, no brute force.
+  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, 14), GpuBvhLayout::Binary);
+  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, 1310734), GpuBvhLayout::Binary);
   GpuBvhOptions o;
   o.brute_max_triangles = 20;
   EXPECT_EQ(resolve_layout(o, 20), GpuBvhLayout::Brute);

@@ -20,12 +20,13 @@ namespace pb::gpu {
 
 enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4 };
 
-// Defaults of `auto`, to be set from the device measurements (gpu/NOTES.md,
-// "Traversal layouts"; `gpu/run_on_device.sh layouts` measures them). Until then, by
-// instruction counts: one wide8 node holds a scene of up to 24 triangles, and a shadow
-// ray through the empty box tests none of them there but every one under brute force.
-constexpr GpuBvhLayout kAutoLayout = GpuBvhLayout::Wide8;
-constexpr uint32_t kDefaultBruteMaxTriangles = 8;
+// Measured on an H100 (results/nvidia-h100-80gb-hbm3/layouts-a12fc4c, interleaved,
+// CUDA events): the binary BVH is the fastest everywhere we measured — paper-cornell
+// 256x256x800 pixel 13.7 ms (wide8 19.7, wide4 38.2, brute 18.4), wavefront 19.2 ms
+// (wide8 21.5, brute 25.5); ico:8 pixel 75.8 ms (wide8 114.2, wide4 147.3); brute force
+// never beat it, so auto means binary and brute force is off unless asked for.
+constexpr GpuBvhLayout kAutoLayout = GpuBvhLayout::Binary;
+constexpr uint32_t kDefaultBruteMaxTriangles = 0;
 constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute force is never the answer
 
 struct GpuBvhOptions {
