@@ -29,6 +29,7 @@
 #include "shade_batch.h"
 #include "strategies.h"
 #include "tiny_scene.h"
+#include "wavefront_pool.h"
 
 #ifndef PB_CPU_KINDS
 #define PB_CPU_KINDS kDiffuseOnly
@@ -43,51 +44,6 @@ namespace {
 // path step. (Measured with callgrind on an AVX2 machine: 16-wide packets ran through
 // the same Embree kernel at the same instruction count there.)
 // (intersect_packet, occluded_packet: embree_rays.h.)
-
-// Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
-// are neighbours on the image (coherent camera rays).
-class SampleSource {
- public:
-  SampleSource(uint64_t total, uint32_t pixels, uint32_t first_sample)
-      : total_(total), pixels_(pixels), first_(first_sample) {}
-  // Claims up to n samples; returns the first global index and sets n to the count.
-  uint64_t claim(uint64_t& n) {
-    uint64_t start = next_.fetch_add(n, std::memory_order_relaxed);
-    n = start >= total_ ? 0 : std::min(n, total_ - start);
-    return start;
-  }
-  uint32_t pixel_of(uint64_t g) const { return uint32_t(g % pixels_); }
-  uint32_t sample_of(uint64_t g) const { return first_ + uint32_t(g / pixels_); }
-
- private:
-  std::atomic<uint64_t> next_{0};
-  uint64_t total_;
-  uint32_t pixels_;
-  uint32_t first_;  // samples [first_, first_ + total_ / pixels_) of each pixel
-};
-
-template <class T> struct PoolSlice {
-  explicit PoolSlice(size_t n) : state(n), shadow(n), prim(n) {
-    free.reserve(n);
-    live.reserve(n);
-    next_live.reserve(n);
-    shadowed.reserve(n);
-    done.reserve(n);
-    for (size_t i = n; i-- > 0;) free.push_back(uint32_t(i));
-  }
-  std::vector<PathState<T>> state;
-  std::vector<ShadowQuery<T>> shadow;
-  std::vector<uint32_t> prim;  // hit triangle, or RTC_INVALID_GEOMETRY_ID
-  std::vector<uint32_t> free, live, next_live, shadowed, done;
-
-  static constexpr size_t bytes_per_path =
-      sizeof(PathState<T>) + sizeof(ShadowQuery<T>) + sizeof(uint32_t) * 6;
-};
-
-struct Local {
-  RayCounts rays;
-  uint64_t paths = 0, discarded = 0;
-};
 
 // With kernels `k` (float, a vector ISA) k->lanes new paths at a time (begin_paths).
 template <class T>
