@@ -8,6 +8,8 @@
 #include <iterator>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
+#include <cstdio>
 
 #include "pathbench/analysis/bench_compare.h"
 #include "pathbench/common/errors.h"
@@ -54,12 +56,18 @@ std::string wall_only_copy(const std::string& in, double f, const std::string& n
 }
 
 // Runs the command line; returns its exit status and (in *out) its stdout.
+// The output file is this process's own: CTest runs each test as a process of its own,
+// several at once (-j), and a shared name let one test read another's output.
 int cli_out(const std::string& args, std::string* out) {
-  const std::string file = std::string(PATHBENCH_TEST_TMP) + "/cli-out.txt";
+  static int calls = 0;
+  const std::string file =
+      std::string(PATHBENCH_TEST_TMP) + "/cli-out-" + std::to_string(getpid()) + "-" + std::to_string(calls++) + ".txt";
   const std::string cmd = std::string(PATHBENCH_CLI) + " compare " + args + " > " + file + " 2>/dev/null";
   const int st = std::system(cmd.c_str());
   std::ifstream in(file);
   out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  in.close();
+  std::remove(file.c_str());
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
