@@ -2,8 +2,6 @@
 // resolve to a small OBJ or PLY held in memory, by extension (so the fuzzer explores
 // the XML, transforms, BSDFs and instancing, not the file system); names containing
 // "missing" do not exist.
-#include <fmt/core.h>
-
 #include "fuzz_util.h"
 #include "scene_io/scene_io.h"
 
@@ -14,17 +12,12 @@ const char* const kPly =
     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
 
-std::string read_fixed(const std::string& path, const char* what, uint64_t max_bytes) {
-  const std::string text = path.size() > 4 && path.substr(path.size() - 4) == ".ply" ? kPly : kObj;
-  if (text.size() > max_bytes) throw pb::InputError(fmt::format("{}: {} over the limit", path, what));
-  return text;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const pb::scene_io::FileReader reader{
-      read_fixed, [](const std::string& path) { return path.find("missing") == std::string::npos; }};
+  static const pb::scene_io::FileReader reader = pb::fuzz::memory_reader([](const std::string& path) {
+    return path.size() > 4 && path.substr(path.size() - 4) == ".ply" ? kPly : kObj;
+  });
   const std::string text = pb::fuzz::text_of(data, size);
   pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene_mitsuba("fuzz/scene.xml", text, reader); });
   return 0;

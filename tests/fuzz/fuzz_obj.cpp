@@ -1,8 +1,6 @@
 // The OBJ reader (and the MTL reader behind `mtllib`) on arbitrary bytes, through
 // Scene::finalize. The input is an OBJ file; everything after a line "#mtl" is handed
 // to it as the contents of whichever MTL library it names.
-#include <fmt/core.h>
-
 #include "fuzz_util.h"
 #include "scene_io/scene_io.h"
 
@@ -12,12 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string obj = split == std::string::npos ? input : input.substr(0, split + 1);
   const std::string mtl = split == std::string::npos ? std::string() : input.substr(split + 6);
   // A library named "missing..." does not exist; every other name is the MTL part.
-  const pb::scene_io::FileReader reader{
-      [&](const std::string& path, const char* what, uint64_t max_bytes) {
-        if (mtl.size() > max_bytes) throw pb::InputError(fmt::format("{}: {} over the limit", path, what));
-        return mtl;
-      },
-      [](const std::string& path) { return path.find("missing") == std::string::npos; }};
+  const pb::scene_io::FileReader reader = pb::fuzz::memory_reader([&](const std::string&) { return mtl; });
   pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene_obj("fuzz/mesh.obj", obj, reader); });
   return 0;
 }
