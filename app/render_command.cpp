@@ -167,7 +167,7 @@ int run_render(RenderOptions& o) {
     f.write(report.to_json().dump(2) + "\n");
     f.finish();
   }
-  for (OutputFile& f : outputs) f.commit();
+  commit_all(outputs);
   if (!o.quiet) {
     fmt::print("{} {}x{} {} spp, {} bounces, {} sampling, {}, {}/{}: {:.3f} s, {:.2f} M rays/s ({} rays, {} paths",
                scene.name, o.settings.width, o.settings.height, o.settings.spp,

@@ -39,22 +39,6 @@ std::string reason(int err) { return std::strerror(err); }
   throw InputError(fmt::format("{} {}: {}", option, display_path(path), why));
 }
 
-// Blocks the signals that remove temporary files while one is created and entered
-// in the table, so that none is created and then missed.
-class BlockCleanupSignals {
- public:
-  BlockCleanupSignals() {
-    sigset_t s;
-    sigemptyset(&s);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&s, sig);
-    pthread_sigmask(SIG_BLOCK, &s, &old_);
-  }
-  ~BlockCleanupSignals() { pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
-
- private:
-  sigset_t old_;
-};
-
 // Creates ".NAME.XXXXXX.tmp" in `dir` ("" = the current folder) exclusively, with a
 // random part, and returns its descriptor (-1 and errno on failure). The name part
 // is cut so that the temporary name stays within NAME_MAX.
@@ -159,7 +143,7 @@ void check_output_path(const std::string& path, const std::string& option) {
   // The only test that holds for every reason (permissions, a read-only mount, root,
   // ACLs): create a file there.
   std::string temp;
-  BlockCleanupSignals block;  // the probe file is not in the cleanup table
+  detail::FileChangeSection section;  // the probe file is not in the cleanup table
   const int fd = create_temp(folder == "." && !p.has_parent_path() ? "" : folder.string(), name, temp);
   if (fd < 0)
     refuse(option, path, fmt::format("cannot create a file in {}: {}", display_path(folder.string()), reason(errno)));
@@ -177,7 +161,7 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
       throw InputError(fmt::format("{}: cannot create the folder {}: {}", display_path(path_),
                                    display_path(p.parent_path().string()), ec.message()));
   }
-  BlockCleanupSignals block;
+  detail::FileChangeSection section;  // created and registered before a signal can clean up
   fd_ = create_temp(p.has_parent_path() ? p.parent_path().string() : std::string(), p.filename().string(), temp_);
   if (fd_ < 0) {
     const int err = errno;
@@ -245,6 +229,7 @@ void OutputFile::finish() {
 
 void OutputFile::commit() {
   finish();
+  detail::FileChangeSection section;  // renamed and unregistered before a signal can clean up
   if (::rename(temp_.c_str(), path_.c_str()) != 0) {
     const int err = errno;
     fail(err == EISDIR ? std::string("cannot replace it") : std::string("cannot rename the finished file into place"),
@@ -260,6 +245,12 @@ void OutputFile::commit() {
   }
   detail::unregister_temp_file(slot_);
   slot_ = -1;
+}
+
+void commit_all(std::vector<OutputFile>& files) {
+  for (OutputFile& f : files) f.finish();
+  detail::FileChangeSection section;  // a signal sees all of them renamed, or none
+  for (OutputFile& f : files) f.commit();
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

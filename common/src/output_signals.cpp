@@ -3,6 +3,7 @@
 // allocation, no locks) and calls async-signal-safe functions: unlink, kill, write,
 // sigaction, raise.
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <array>
@@ -29,6 +30,23 @@ struct Slot {
 };
 std::array<Slot, kSlots> g_slots;
 std::atomic<pid_t> g_child{0};
+// Dekker-style gate between FileChangeSection and the handler (both sequentially
+// consistent): either the section sees g_stopping set, or the handler sees g_open > 0.
+std::atomic<int> g_open{0};
+std::atomic<bool> g_stopping{false};
+// Sections open on this thread: one opened inside another (commit_all's commits)
+// must finish, since the handler is already waiting for the outer one.
+thread_local int t_depth = 0;
+
+constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+
+// Waits (async-signal-safely) until no FileChangeSection is open: they are short (a
+// create, a rename, an fsync), but a stuck disk must not keep a signal from ending
+// the process, so the wait gives up after 10 s.
+void wait_for_open_sections() {
+  const timespec step{0, 1'000'000};  // 1 ms
+  for (int i = 0; i < 10'000 && g_open.load() > 0; ++i) ::nanosleep(&step, nullptr);
+}
 
 const char* signal_name(int sig) {
   switch (sig) {
@@ -42,6 +60,8 @@ const char* signal_name(int sig) {
 
 void on_fatal_signal(int sig) {
   const int saved = errno;
+  g_stopping.store(true);
+  wait_for_open_sections();
   const pid_t child = g_child.load(std::memory_order_acquire);
   if (child > 0) ::kill(child, sig);
   bool removed = false;
@@ -60,6 +80,26 @@ void on_fatal_signal(int sig) {
 }
 
 }  // namespace
+
+FileChangeSection::FileChangeSection() noexcept {
+  sigset_t s;
+  sigemptyset(&s);
+  for (int sig : kCleanupSignals) sigaddset(&s, sig);
+  pthread_sigmask(SIG_BLOCK, &s, &old_);
+  g_open.fetch_add(1);
+  if (t_depth++ == 0 && g_stopping.load()) {
+    // A handler on another thread is removing files and will end the process; this
+    // thread must not create or rename one behind it.
+    g_open.fetch_sub(1);
+    for (;;) ::pause();
+  }
+}
+
+FileChangeSection::~FileChangeSection() {
+  --t_depth;
+  g_open.fetch_sub(1);
+  pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+}
 
 int register_temp_file(const char* path) noexcept {
   const size_t n = std::strlen(path);
@@ -83,13 +123,13 @@ void unregister_temp_file(int slot) noexcept {
 }  // namespace detail
 
 void install_output_signal_cleanup() {
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+  for (int sig : detail::kCleanupSignals) {
     struct sigaction old {};
     if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;  // e.g. nohup, `cmd &`
     struct sigaction sa {};
     sa.sa_handler = detail::on_fatal_signal;
     sigemptyset(&sa.sa_mask);
-    for (int other : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&sa.sa_mask, other);  // one cleanup at a time
+    for (int other : detail::kCleanupSignals) sigaddset(&sa.sa_mask, other);  // one cleanup at a time
     sa.sa_flags = SA_RESETHAND;
     ::sigaction(sig, &sa, nullptr);
   }

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace pb {
 
@@ -58,6 +59,11 @@ class OutputFile {
   int slot_ = -1;        // this temp file's entry in the signal-cleanup table
   bool finished_ = false, committed_ = false;
 };
+
+// Commits a set of outputs of one run (an image, its variance, its report): a fatal
+// signal meanwhile (install_output_signal_cleanup) waits until all are renamed into
+// place, so it leaves all of them or, if it came first, none.
+void commit_all(std::vector<OutputFile>& files);
 
 // Writes `text` to `path` through an OutputFile.
 void write_text_file(const std::string& path, const std::string& text);
