@@ -1,4 +1,5 @@
 #include "bench_context.h"
+#include "bench_ranks.h"
 
 #include <benchmark/benchmark.h>
 #include <fmt/chrono.h>
@@ -78,6 +79,9 @@ void add_environment_context(const std::string& preset) {
   add("git_revision", rev.empty() ? "unknown" : rev);
   add("date_utc", utc_now());
   add("load_average_at_start", first_line("/proc/loadavg"));
+  // mpirun -np N: each render iteration is one frame over N ranks (bench_ranks.h); the
+  // fingerprint and load are rank 0's host's.
+  add("mpi_ranks", std::to_string(bench_ranks()));
   if (fp.contains("gpu") && fp["gpu"].contains("name")) {
     add("gpu_name", fp["gpu"]["name"].get<std::string>());
     add("gpu_driver", fp["gpu"]["driver"].get<std::string>());

@@ -18,6 +18,9 @@
 // --benchmark_out=FILE.json, then `pathbench compare BASE.json FILE.json`. That file is
 // strict JSON with the machine fingerprint (bench_context.h); so is the JSON on stdout
 // (--benchmark_format=json), printed once the run has finished.
+//
+// Under mpirun (`mpirun -np N pathbench-bench ...`) each render benchmark iteration is
+// one frame over the N ranks (bench_ranks.h).
 #include <benchmark/benchmark.h>
 #include <fmt/core.h>
 
@@ -29,6 +32,8 @@
 #include <vector>
 
 #include "bench_context.h"
+#include "bench_ranks.h"
+#include "pathbench/run/world.h"
 #if PATHBENCH_BENCH_GPU
 #include "pathbench/gpu/bvh_layout.h"
 #endif
@@ -132,7 +137,17 @@ void preset_gpu_layouts() {
 }  // namespace
 }  // namespace pb::bench
 
-int main(int argc, char** argv) {
+namespace {
+int run_benchmarks(int argc, char** argv);
+}
+
+// Under mpirun every rank parses the same command line and registers the same
+// benchmarks; rank 0 runs them, the others follow its frames (bench_ranks.h).
+// World::end finalizes MPI (or aborts every rank for a failure only this one knows).
+int main(int argc, char** argv) { return pb::run::World::end(run_benchmarks(argc, argv)); }
+
+namespace {
+int run_benchmarks(int argc, char** argv) {
   // --preset NAME / --preset=NAME, removed from argv before Google Benchmark sees it.
   std::string preset = "quick";
   std::vector<char*> args;
@@ -175,6 +190,7 @@ int main(int argc, char** argv) {
   args.push_back(nullptr);
   benchmark::Initialize(&new_argc, args.data());
   if (benchmark::ReportUnrecognizedArguments(new_argc, args.data())) return 2;
+  if (pb::bench::bench_follower()) return pb::bench::follow_rank0();
   pb::bench::add_environment_context(preset);
   // --benchmark_format=json: Google Benchmark's JSON reporter writes into a buffer,
   // printed after the run in the same strict form as the output file.
@@ -187,6 +203,7 @@ int main(int argc, char** argv) {
   } else {
     benchmark::RunSpecifiedBenchmarks();
   }
+  pb::bench::release_followers();
   benchmark::Shutdown();
   if (display_format == "json") {
     try {
@@ -206,3 +223,4 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+}  // namespace

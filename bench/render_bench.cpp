@@ -11,6 +11,7 @@
 #include "pathbench/common/report.h"
 #include "pathbench/run/run.h"
 #include "bench_context.h"
+#include "bench_ranks.h"
 #include "scene_cache.h"
 
 namespace pb::bench {
@@ -52,12 +53,17 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   uint64_t rays = 0, paths = 0;
   RunReport last;
   uint64_t peak_host = 0, peak_device = 0, tracer_host = 0;
-  double cpu_seconds = 0;
+  double cpu_seconds = 0, efficiency = 0, balance = 0;
+  const std::string name = render_benchmark_name(c);
+  const bool ranks = bench_ranks() > 1;
   for (auto _ : state) {
     reset_peak_rss();
     RunReport r;
     try {
-      run::render(*scene, s, film, r);
+      // Over MPI ranks: one frame of every rank, timed from their common start to the
+      // film reduced on rank 0 (report.seconds, and device_seconds on GPUs).
+      if (ranks) render_frame_over_ranks(name, *scene, s, film, r);
+      else run::render(*scene, s, film, r);
     } catch (const std::exception& e) {
       state.SkipWithError(e.what());
       break;
@@ -69,9 +75,13 @@ void run_render(benchmark::State& state, const RenderCase& c) {
     peak_device = std::max(peak_device, r.peak_device_bytes);
     tracer_host = std::max(tracer_host, r.tracer_host_bytes);
     cpu_seconds += r.load.value("process_cpu_seconds", 0.0);
+    if (ranks) {
+      efficiency += r.extra["ranks"].value("parallel_efficiency", 0.0);
+      balance += r.extra["ranks"].value("load_balance", 0.0);
+    }
     last = r;
   }
-  if (last.extra.contains("film_hash")) record_film_hash(render_benchmark_name(c), last.extra["film_hash"].get<std::string>());
+  if (last.extra.contains("film_hash")) record_film_hash(name, last.extra["film_hash"].get<std::string>());
   using benchmark::Counter;
   state.counters["rays_per_second"] = Counter(double(rays), Counter::kIsRate);
   state.counters["paths_per_second"] = Counter(double(paths), Counter::kIsRate);
@@ -88,6 +98,11 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   // Process CPU time (every thread) per iteration, around the whole render call: beside
   // the wall time it tells a contended run (wall up, CPU flat) from a slower one.
   state.counters["process_cpu_seconds"] = Counter(cpu_seconds, Counter::kAvgIterations);
+  if (ranks) {  // rank 0's report over all ranks (ranks_report.h); process_cpu_seconds is rank 0's own
+    state.counters["ranks"] = double(bench_ranks());
+    state.counters["parallel_efficiency"] = Counter(efficiency, Counter::kAvgIterations);
+    state.counters["load_balance"] = Counter(balance, Counter::kAvgIterations);
+  }
   // Which Embree layout the CPU traced (auto decides per scene and process) and which
   // instruction set its path step ran (--isa auto: the widest the CPU has): a change of
   // either between two runs shows here, not only as a change of speed.
@@ -108,6 +123,7 @@ std::string render_benchmark_name(const RenderCase& c) {
 void register_render_benchmark(const RenderCase& c) {
   RenderCase copy = c;
   copy.settings.progress = false;
+  remember_render_case(render_benchmark_name(copy), copy);
   auto* b = benchmark::RegisterBenchmark(render_benchmark_name(copy).c_str(),
                                          [copy](benchmark::State& st) { run_render(st, copy); });
   b->UseManualTime()->Unit(benchmark::kMillisecond);

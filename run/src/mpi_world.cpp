@@ -1,6 +1,7 @@
 // The MPI world (built when PATHBENCH_MPI finds MPI): started on first use when a PMI
 // launcher (mpirun) started this process, one rank otherwise. Collectives for the rank
 // render: failure agreement, string exchange, and the exact film reduction.
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -116,6 +117,23 @@ std::vector<std::string> World::local_all(const std::string& mine) {
 }
 void World::barrier() {
   if (mpi_) MPI_Barrier(MPI_COMM_WORLD);
+}
+std::string World::announce(const std::string& message) {
+  if (!mpi_ || size_ == 1) return message;
+  uint64_t len = root() ? message.size() : 0;
+  MPI_Request request = MPI_REQUEST_NULL;
+  MPI_Ibcast(&len, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD, &request);
+  const timespec step{0, 1'000'000};
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) break;
+    if (!root()) ::nanosleep(&step, nullptr);
+  }
+  std::string out = root() ? message : std::string(size_t(len), '\0');
+  // Announcements are short (a benchmark's name); MPI counts are int.
+  if (len > uint64_t(INT_MAX)) throw std::length_error("World::announce: message too long");
+  MPI_Bcast(out.data(), int(len), MPI_CHAR, 0, MPI_COMM_WORLD);
+  return out;
 }
 bool World::can_dispense() const { return !mpi_ || threads_ok_; }
 

@@ -9,6 +9,8 @@
 # killed_rank     rank 1 SIGKILLed mid-render: the run ends within 30 s, non-zero, no image
 # accuracy        `accuracy --quick`: the ranks' reference equals the one-process reference
 # reproduce       `reproduce --device cpu --spp 16`: the ranks' images equal one process's
+# bench           `mpirun -np 2 pathbench-bench` (and `pathbench bench --out`): each render
+#                 iteration is a frame over both ranks, with one process's film hashes
 # gpu2, hybrid    (CUDA builds; skipped, status 77, without a usable GPU) 2 GPU ranks, and
 #                 --device hybrid (GPU + CPU ranks, dynamic), give the one-GPU image
 # Small frames (64x64): each case takes a few seconds on 2 cores.
@@ -100,6 +102,29 @@ case $case_name in
     done
     [ $n -ge 2 ] || fail "no images to compare"
     grep -q '"parallel_efficiency"' two/paper-cornell-report.json || fail "the rows' reports have no ranks section" ;;
+  bench)
+    bb=$(dirname "$pb")/pathbench-bench
+    [ -x "$bb" ] || { echo "no pathbench-bench in this build: skipped"; exit 77; }
+    quick="--preset quick --benchmark_min_time=0.01"
+    "$bb" $quick --benchmark_filter=render/cpu/ --benchmark_out=one.json >one.log 2>&1 ||
+      { cat one.log >&2; fail "one process failed"; }
+    run -np 2 "$bb" $quick --benchmark_filter=render/cpu/ --benchmark_out=two.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "pathbench-bench over 2 ranks: status $status"; }
+    run -np 2 "$pb" bench $quick --out cli.json --benchmark_filter=render/cpu/pixel
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "pathbench bench over 2 ranks: status $status"; }
+    python3 - one.json two.json cli.json <<'EOF_PY' || fail "the benchmark JSON of the ranks is not one process's"
+import json, sys
+one, two, cli = (json.load(open(p)) for p in sys.argv[1:])
+h1, h2, hc = (j["context"]["film_hashes"] for j in (one, two, cli))
+assert len(h1) == 4, f"expected pixel/wavefront x uniform/nee, got {sorted(h1)}"
+assert h2 == h1, f"2 ranks {h2} != 1 process {h1}"
+assert len(hc) == 2 and all(hc[k] == h1[k] for k in hc), f"pathbench bench over 2 ranks {hc} != {h1}"
+assert one["context"]["mpi_ranks"] == "1" and two["context"]["mpi_ranks"] == "2" and cli["context"]["mpi_ranks"] == "2"
+for b in two["benchmarks"] + cli["benchmarks"]:
+    assert b["ranks"] == 2 and 0 < b["parallel_efficiency"] <= 1 and b["load_balance"] >= 1, b
+print("ranks.sh bench: film hashes of 2 ranks = 1 process:", ", ".join(sorted(h1)))
+EOF_PY
+    [ "$(ls | grep -c '\.tmp')" = 0 ] || fail "a temporary file was left: $(ls)" ;;
   gpu2|hybrid)
     "$pb" $frame --device gpu --out gpu.pfm 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
     if [ $case_name = gpu2 ]; then run -np 2 "$pb" $frame --device gpu --out x.pfm

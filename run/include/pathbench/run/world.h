@@ -3,7 +3,8 @@
 // MPI (PATHBENCH_MPI) and started by mpirun, otherwise one rank. Two implementations of
 // the same class: run/src/mpi_world.cpp (MPI) and run/src/single_world.cpp (one rank), so
 // nothing above this header knows whether MPI exists. Only the run layer's rank render
-// (ranks_render.h) and the process's entry and exit (app/main.cpp) use it.
+// (ranks_render.h), the process's entry and exit (app/main.cpp, bench/bench_main.cpp)
+// and the benchmarks' rank followers (bench/bench_ranks.cpp) use it.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -54,6 +55,10 @@ class World {
   std::vector<std::string> gather(const std::string& mine);
   std::vector<std::string> local_all(const std::string& mine);
   void barrier();
+  // Collective: rank 0's `message` on every rank (the others' argument is ignored).
+  // Ranks waiting for rank 0 sleep between polls (1 ms) instead of spinning a core, so
+  // that work rank 0 does alone meanwhile (a benchmark of its own) is not slowed.
+  std::string announce(const std::string& message);
   // Collective: adds every rank's film into rank 0's, exactly (64-bit integer sums,
   // MPI_Reduce over MPI_INT64_T; the rules of reduce_film: same size, scale and variance,
   // overflow refused with std::overflow_error on rank 0). Other ranks' films are left as
