@@ -1,3 +1,4 @@
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/scene.h"
 
 #include <fmt/core.h>
@@ -121,8 +122,8 @@ void Scene::finalize() {
     }
   }
   if (dropped_triangles)
-    fmt::print(stderr, "warning: {}: dropped {} zero-area triangle{}\n", name, dropped_triangles,
-               dropped_triangles == 1 ? "" : "s");
+    scene_warning(fmt::format("{}: dropped {} zero-area triangle{}", name, dropped_triangles,
+                              dropped_triangles == 1 ? "" : "s"));
   if (kept.empty()) throw InputError(fmt::format("{}: every triangle has zero area", name));
   triangles = std::move(kept);
   material_ids = std::move(kept_mat);

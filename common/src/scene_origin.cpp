@@ -12,6 +12,7 @@
 
 #include <cmath>
 
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene.h"
 
@@ -61,13 +62,13 @@ void Scene::rebase_far_from_origin() {
   const double largest = max_component(vmax(vabs(user_lo), vabs(user_hi)));
   const double steps = extent / float_step(largest);
   if (extent > 0 && steps < kMinFloatStepsAcross)
-    fmt::print(stderr,
-               "warning: {}: the scene is {:.3g} units across but lies {:.3g} units from the origin: float32 "
+    scene_warning(fmt::format(
+               "{}: the scene is {:.3g} units across but lies {:.3g} units from the origin: float32 "
                "coordinates there have steps of {:.3g}, only {:.0f} across the scene, so its vertices were "
                "rounded by up to 1/{:.0f} of its size when they were read. The image may differ from the same "
                "scene near the origin (unchanged up to {:.0f} steps across); move the scene's coordinates "
-               "closer to the origin.\n",
-               name, extent, largest, float_step(largest), steps, 2 * steps, kMinFloatStepsAcross);
+               "closer to the origin.",
+               name, extent, largest, float_step(largest), steps, 2 * steps, kMinFloatStepsAcross));
 }
 
 Scene transformed(Scene s, float scale, Vec3f offset) {

@@ -18,6 +18,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/run/run.h"
 #include "ray_cast.h"
 #include "render_binding.h"
@@ -100,16 +101,29 @@ py::array_t<bool> occluded(const SceneHandle& s, const py::handle& origins, cons
 }
 
 std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::array<float, 3> offset,
-                                  const std::string& embree_layout) {
+                                  const std::string& embree_layout, bool strict) {
   EmbreeLayout layout;
   try {
     layout = parse_embree_layout(embree_layout);
   } catch (const InputError& e) {
     throw py::value_error(pb::python::python_terms(e.what()));
   }
-  py::gil_scoped_release release;
-  return std::make_shared<SceneHandle>(
-      pb::transformed(load_scene(name), scale, Vec3f{offset[0], offset[1], offset[2]}), layout);
+  std::shared_ptr<SceneHandle> handle;
+  std::vector<SceneWarningCollector::Message> said;
+  {
+    py::gil_scoped_release release;
+    SceneWarningCollector collect;  // this thread's scene warnings, raised below as Python warnings
+    handle = std::make_shared<SceneHandle>(
+        pb::transformed(load_scene(name, {.strict = strict}), scale, Vec3f{offset[0], offset[1], offset[2]}), layout);
+    said = collect.messages();
+  }
+  // UserWarning (warnings.filterwarnings("error") makes them exceptions, as --strict
+  // does for what is not modelled).
+  for (const auto& m : said) {
+    const std::string text = (m.kind == SceneMessage::Note ? "note: " : "") + m.text;
+    if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+  }
+  return handle;
 }
 
 }  // namespace
@@ -192,9 +206,12 @@ PYBIND11_MODULE(_core, m) {
 
   m.def("load_scene", &load, py::arg("name_or_path"), py::arg("scale") = 1.0f,
         py::arg("offset") = std::array<float, 3>{0, 0, 0}, py::arg("embree_layout") = "auto",
-        "A built-in scene ('paper-cornell', 'scaling:100000', ...) or a .json/.obj file, every point moved to\n"
-        "p * scale + offset (the camera too); embree_layout as `--embree-layout` (auto, triangles, quads) for the\n"
-        "CPU ray casts. ValueError names what is wrong.");
+        py::arg("strict") = false,
+        "A built-in scene ('paper-cornell', 'scaling:100000', ...) or a scene file (.json, .obj, .ply, .gltf,\n"
+        ".glb, Mitsuba 3 .xml), every point moved to p * scale + offset (the camera too); embree_layout as\n"
+        "`--embree-layout` (auto, triangles, quads) for the CPU ray casts. What the file holds that pathbench\n"
+        "does not model is a UserWarning, or with strict=True (`render --strict`) a ValueError. ValueError\n"
+        "names what is wrong.");
   m.def("builtin_scenes", [] {
     py::list out;
     for (const auto& b : pb::builtin_scenes()) out.append(py::make_tuple(b.name, b.description));

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <unordered_map>
 
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/json_input.h"
@@ -304,8 +305,8 @@ class JsonSceneReader {
       }
       if (grey == ~0u) {
         grey = scenes::add_material(s, file + ":default", {0.5f, 0.5f, 0.5f});
-        fmt::print(stderr, "note: {}: mesh '{}' has faces without a material (no \"material\" given, none from an MTL "
-                           "file); they get a grey default (albedo 0.5)\n", path_, file);
+        scene_note(fmt::format("{}: mesh '{}' has faces without a material (no \"material\" given, none from an MTL "
+                               "file); they get a grey default (albedo 0.5)", path_, file));
       }
       ids[i] = grey;
     }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
@@ -20,7 +21,7 @@ namespace fs = std::filesystem;
 
 void Losses::report(const std::string& path, const std::string& what) const {
   if (strict_) throw InputError(fmt::format("{}: {}: not modelled by pathbench (--strict)", path, what));
-  if (said_.insert(what).second) fmt::print(stderr, "warning: {}: {} (not modelled; ignored)\n", path, what);
+  if (said_.insert(what).second) scene_warning(fmt::format("{}: {} (not modelled; ignored)", path, what));
 }
 
 FileReader disk_reader() {
@@ -141,8 +142,8 @@ void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const c
   if (set_camera) s.camera = framing_camera(lo, hi);
   if (!has_emitter) {
     add_default_light(s, lo, hi);
-    fmt::print(stderr, "note: {}: no emissive material ({}); added a default area light above the model\n", path,
-               emitter_hint);
+    scene_note(fmt::format("{}: no emissive material ({}); added a default area light above the model", path,
+                           emitter_hint));
   }
 }
 

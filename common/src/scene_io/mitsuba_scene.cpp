@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
 #include "scene_io/mitsuba.h"
 #include "scenes/builder.h"
@@ -198,8 +199,8 @@ class MitsubaReader {
       const float radius = float(p.number("radius", 1));
       if (!(radius > 0)) doc_.fail(n, "the radius must be above 0");
       mesh = mitsuba::sphere_mesh(p.point("center", {0, 0, 0}), radius);
-      fmt::print(stderr, "warning: {}: {}: tessellated into {} triangles (pathbench traces triangles only)\n",
-                 doc_.path, Document::describe(n), mesh.triangles.size());
+      scene_warning(fmt::format("{}: {}: tessellated into {} triangles (pathbench traces triangles only)", doc_.path,
+                                Document::describe(n), mesh.triangles.size()));
     } else {
       doc_.losses->report(doc_.path, fmt::format("shape '{:.30}' (obj, ply, rectangle, cube, sphere and instance only)", type));
       return;

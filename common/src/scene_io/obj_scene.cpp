@@ -19,6 +19,7 @@
 #include <string_view>
 #include <unordered_set>
 
+#include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
@@ -263,7 +264,7 @@ ObjData read_obj(const std::string& path, const std::string& text, bool with_mat
     if (!warn.empty()) {
       while (!warn.empty() && warn.back() == '\n') warn.pop_back();
       if (warn.size() > 2000) warn = warn.substr(0, 2000) + "...";
-      fmt::print(stderr, "warning: {}: {}\n", path, warn);
+      scene_warning(fmt::format("{}: {}", path, warn));
     }
   }
   const uint32_t nv = uint32_t(mesh.positions.size());
