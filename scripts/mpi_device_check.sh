@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # MPI ranks on a GPU host (issue 13), for the device machine: build with MPI, run the
 # mpi tests, check that 2 GPU ranks (on one GPU when only one is visible) and the
-# CPU+GPU hybrid give the one-GPU image byte for byte, and run tools/mpi_scaling.py.
-# Everything lands under $OUT (default ./device-out). Phases: build check scaling.
+# CPU+GPU hybrid give the one-GPU image byte for byte, that pathbench-bench's GPU render
+# benchmarks over 2 ranks give one process's film hashes, and run tools/mpi_scaling.py.
+# Everything lands under $OUT (default ./device-out). Phases: build gpu check bench scaling
+# (gpu: ctest -L gpu in the same build).
 #   source .gpu-deps/unpack.sh is done here (pack-deps.sh --mpi); ../shared/gpu-host/README.md.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 OUT=${OUT:-$PWD/device-out}
 mkdir -p "$OUT"
-phases=${*:-build check scaling}
+phases=${*:-build check bench scaling}
 has() { [[ " $phases " == *" $1 "* ]]; }
 log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
 if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi
@@ -23,11 +25,17 @@ if has build; then
   cmake -S . -B $B -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF -DPATHBENCH_PYTHON=OFF \
         -DPATHBENCH_MPI=ON -DMPI_CXX_COMPILER=$(command -v mpicxx.openmpi || command -v mpicxx) \
         -DCMAKE_CUDA_ARCHITECTURES=90 > "$OUT/configure.txt" 2>&1 || { tail -30 "$OUT/configure.txt"; exit 1; }
-  cmake --build $B -j 16 --target pathbench pathbench_unit_tests > "$OUT/build.txt" 2>&1 \
+  cmake --build $B -j 16 --target pathbench pathbench-bench pathbench_unit_tests pathbench_gpu_tests \
+        pathbench_gpu_stability_tests pathbench_traversal_tests > "$OUT/build.txt" 2>&1 \
     || { grep -E "error|FAILED" -A3 "$OUT/build.txt" | head -60; exit 1; }
   log "build ok"
   (cd $B && ctest -L mpi --output-on-failure -j4 > "$OUT/ctest-mpi.txt" 2>&1; tail -4 "$OUT/ctest-mpi.txt")
   (cd $B && ctest -R 'RankSplit|RunRanks' --output-on-failure > "$OUT/ctest-ranks.txt" 2>&1; tail -3 "$OUT/ctest-ranks.txt")
+fi
+
+if has gpu; then
+  (cd $B && ctest -L gpu --output-on-failure --timeout 300 > "$OUT/ctest-gpu.txt" 2>&1; tail -4 "$OUT/ctest-gpu.txt")
+  log "ctest -L gpu: $(grep -E 'tests passed|tests failed' "$OUT/ctest-gpu.txt")"
 fi
 
 mpi() { "$MPIRUN" --oversubscribe --bind-to none "$@"; }
@@ -51,6 +59,24 @@ if has check; then
     log "$tag seconds [frame share efficiency reduce]: gpu1 $(secs "$OUT/gpu1-$tag.json") | gpu2 $(secs "$OUT/gpu2-$tag.json") | hybrid $(secs "$OUT/hy-$tag.json")"
   done
   rm -f "$OUT"/*.pfm
+fi
+if has bench; then
+  # Every GPU render benchmark of the quick preset: 1 process, then 2 ranks (one frame
+  # over both per iteration); the film hashes must agree, benchmark by benchmark.
+  q="--preset quick --benchmark_filter=render/gpu/ --benchmark_min_time=0.2"
+  $B/bin/pathbench-bench $q --benchmark_out="$OUT/bench-gpu1.json" > "$OUT/bench-gpu1.txt" 2>&1
+  mpi -np 2 $B/bin/pathbench-bench $q --benchmark_out="$OUT/bench-gpu2.json" > "$OUT/bench-gpu2.txt" 2>&1
+  log "bench over ranks: $(python3 - "$OUT/bench-gpu1.json" "$OUT/bench-gpu2.json" <<'EOF_PY'
+import json, sys
+one, two = (json.load(open(p)) for p in sys.argv[1:])
+h1, h2 = one["context"]["film_hashes"], two["context"]["film_hashes"]
+rows = {b["name"]: b for b in two["benchmarks"]}
+same = sum(h1[k] == h2.get(k) for k in h1)
+print(f"{same}/{len(h1)} GPU render benchmarks with one process's film hash over {two['context']['mpi_ranks']} ranks;",
+      "; ".join(f"{k.split('/')[2]}/{k.split('/')[-1]}: {rows[k + '/manual_time']['real_time']:.2f} ms, efficiency "
+                f"{rows[k + '/manual_time']['parallel_efficiency']:.2f}" for k in sorted(h2)))
+EOF_PY
+)"
 fi
 if has scaling; then
   python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" --cpu-ranks 1,2,4 --reps 3 \
