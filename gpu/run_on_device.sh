@@ -21,7 +21,8 @@ log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
 B=build-gpu
 PB=$B/bin/pathbench
 
-# The commit this tree was (a copy of), for the reports: the device has no .git.
+# The commit this tree is a copy of, for the reports (a .git in the copy, if any, is stale;
+# cmake/git_revision.cmake lets this name win).
 if [ -f .gpu-deps/source-commit ]; then export PATHBENCH_SOURCE_COMMIT=$(cat .gpu-deps/source-commit); fi
 log "source commit: ${PATHBENCH_SOURCE_COMMIT:-unknown}"
 if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi

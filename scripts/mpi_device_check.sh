@@ -13,6 +13,8 @@ mkdir -p "$OUT"
 phases=${*:-build check bench scaling}
 has() { [[ " $phases " == *" $1 "* ]]; }
 log() { echo "== $(date -u +%H:%M:%S) $*" | tee -a "$OUT/summary.txt"; }
+# The tree here is a copy (its .git, if any, is not this commit's): name the commit.
+if [ -f .gpu-deps/source-commit ]; then export PATHBENCH_SOURCE_COMMIT=$(cat .gpu-deps/source-commit); fi
 if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 NCCL_NVLS_ENABLE=0
 MPIRUN=$(command -v mpirun.openmpi || command -v mpirun)
