@@ -1,5 +1,5 @@
-// The wavefront and paper-queue strategies' frame loop: schedule, generate, intersect,
-// shade and shadow launched in turn on one stream (no host wait between them), the
+// The wavefront and paper-queue strategies' frame loop: schedule, intersect, shade and
+// shadow launched in turn on one stream (no host wait between them), the
 // counters read back every few iterations to see whether the frame is done.
 #include "path_pool.cuh"
 
@@ -18,14 +18,13 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   for (uint64_t it = 0;; ++it) {
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
-    launch.launch("generate", k_wf_generate, 0, g.view, c, cur, ctr, spp);
     with_traversal_kind(g.bvh.kind, [&](auto kind) {  // intersect compiled for the BVH layout
-      launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.bvh, cur, prim_.get(), ctr);
+      launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, spp);
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;
-      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
-      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film);
+      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp);
+      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp);
     });
     if (shadows_.records) {
       with_traversal_kind(g.bvh.kind, [&](auto kind) {

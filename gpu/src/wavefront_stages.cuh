@@ -1,6 +1,7 @@
 #pragma once
 // The wavefront's stage kernels, one per stage: schedule (book the last iteration, plan
-// the refill), generate (camera rays), intersect (closest hit), shade (the shared path
+// the refill with new samples), intersect (closest hit; new samples' camera rays made
+// there and again in shade, never stored), shade (the shared path
 // step; continuing paths compacted into the next buffer, shadow rays queued) and shadow
 // (occlusion, then radiance to the film or the continuing path). Launched by PathPool
 // (path_pool.cu, the only includer).
@@ -37,18 +38,28 @@ __global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint3
   c.live = c.n_cur;
 }
 
-// New samples after the continuing paths; a warp takes consecutive samples of a pixel,
-// as the pixel strategy does (coherent camera rays).
-__global__ void __launch_bounds__(256, 6) k_wf_generate(SceneView s, PathConfig c, PathSoA cur, const WaveCounters* ctr, uint32_t spp) {
-  kernel_prologue();
-  const uint32_t n = ctr->gen_count, dst = ctr->gen_dst;
-  const unsigned long long base = ctr->gen_base;
-  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const unsigned long long g = base + i;
-    PathState<float> st;
-    path_begin(s, c, uint32_t(g / spp), c.first_sample + uint32_t(g % spp), st);
-    store_path(cur, dst + i, st);
-  }
+// This iteration's new samples: indices [gen_dst, n_cur) of the current buffer, after
+// the continuing paths; a warp takes consecutive samples of a pixel, as the pixel
+// strategy does (coherent camera rays). They are never stored: intersect and shade each
+// make the camera path from its sample index (path_begin: one random draw and a camera
+// ray), which costs less than writing 64 bytes a new path and reading them back twice.
+struct NewPaths {
+  uint32_t dst;             // first index of a new path
+  unsigned long long base;  // its sample index in the frame
+  uint32_t spp;
+};
+
+__device__ __forceinline__ NewPaths new_paths(const WaveCounters* ctr, uint32_t spp) {
+  return {ctr->gen_dst, ctr->gen_base, spp};
+}
+
+__device__ __forceinline__ PathState<float> current_path(const SceneView& s, const PathConfig& c, const PathSoA& cur,
+                                                         const NewPaths& fresh, uint32_t i) {
+  if (i < fresh.dst) return load_path(cur, i);
+  const unsigned long long g = fresh.base + (i - fresh.dst);
+  PathState<float> st;
+  path_begin(s, c, uint32_t(g / fresh.spp), c.first_sample + uint32_t(g % fresh.spp), st);
+  return st;
 }
 
 // Blocks an SM for the traversal stages: 5 (48 registers) suits the binary and brute-force
@@ -58,13 +69,24 @@ template <int kKind>
 constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
 
 template <int kKind>  // the BVH layout (traversal.h)
-__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_intersect(BvhView bvh, PathSoA cur, uint32_t* prim, const WaveCounters* ctr) {
+__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_intersect(SceneView s, PathConfig c, BvhView bvh, PathSoA cur, uint32_t* prim,
+                                                                                     const WaveCounters* ctr, uint32_t spp) {
   kernel_prologue();
   const uint32_t n = ctr->n_cur;
+  const NewPaths fresh = new_paths(ctr, spp);
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    const float4 o = cur.o[i], d = cur.d[i];
+    Vec3f o, d;
+    if (i < fresh.dst) {
+      const float4 o4 = cur.o[i], d4 = cur.d[i];
+      o = {o4.x, o4.y, o4.z};
+      d = {d4.x, d4.y, d4.z};
+    } else {
+      const PathState<float> st = current_path(s, c, cur, fresh, i);
+      o = st.ray.o;
+      d = st.ray.d;
+    }
     float t;
-    prim[i] = intersect_closest<true, kKind>(bvh, {o.x, o.y, o.z}, {d.x, d.y, d.z}, kInf, t);
+    prim[i] = intersect_closest<true, kKind>(bvh, o, d, kInf, t);
   }
 }
 
@@ -76,9 +98,11 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
 
 template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
-                                                     const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film) {
+                                                     const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film,
+                                                     uint32_t spp) {
   kernel_prologue();
   const uint32_t n = ctr->n_cur;
+  const NewPaths fresh = new_paths(ctr, spp);
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
     const uint32_t i = base + lane;
@@ -86,7 +110,7 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
     uint32_t pixel = 0;
     Vec3f L_add{0.0f, 0.0f, 0.0f};
     if (i < n) {
-      PathState<float> st = load_path(cur, i);
+      PathState<float> st = current_path(s, c, cur, fresh, i);
       const uint32_t h = prim[i];
       pixel = st.pixel;
       if (h == kNoHit) {
