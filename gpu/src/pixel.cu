@@ -15,37 +15,6 @@ namespace pb::gpu {
 
 namespace {
 
-// One path in registers, in scalar type T (the traversal finds the hit triangle in
-// float either way; surface_hit recomputes the hit in T), with the watertight or the
-// Moeller-Trumbore triangle test, through the BVH layout kKind (traversal.h).
-template <uint32_t Kinds, class T, bool kWatertight, int kKind>
-__device__ __forceinline__ Vec3f trace_path(const SceneView& s, const BvhView& bvh, const PathConfig& c,
-                                            uint32_t pixel, uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
-  PathState<T> st;
-  path_begin(s, c, pixel, sample, st);
-  ShadowQuery<T> q;
-  auto occlusion_test = [&](const ShadowQuery<T>& query) {  // query: q, filled just before
-    ++n_shadow;
-    if (!occluded<kWatertight, kKind>(bvh, Vec3f(query.ray.o), Vec3f(query.ray.d), 1.0f)) shadow_unoccluded(st, query);
-  };
-  for (;;) {
-    if (gpu_final_vertex(s, c, st)) {  // only emitted light can still count
-      if (path_final_query<Kinds>(s, c, st, q)) occlusion_test(q);
-      break;
-    }
-    if (st.depth > 0) ++n_bounce;  // the camera ray is counted per path
-    float t;
-    const uint32_t prim = intersect_closest<kWatertight, kKind>(bvh, Vec3f(st.ray.o), Vec3f(st.ray.d), kInf, t);
-    if (prim == kNoHit) break;
-    bool wants_shadow;
-    const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, prim, st.ray), q, wants_shadow);
-    if (wants_shadow) occlusion_test(q);
-    if (ev == PathEvent::Done) break;
-  }
-  return Vec3f(st.L);
-}
-
-
 // The block's ray and path counts, one atomic per counter per block. (Discarded samples
 // are counted where they are rejected, in film_add_warp.)
 __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths) {
@@ -83,7 +52,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
     const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
+      L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);

@@ -6,6 +6,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/cpu/render.h"
+#include "pathbench/gpu/host_tracer.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/render.h"
 #endif
@@ -13,7 +14,8 @@
 namespace pb::run {
 
 struct RankTracer::Cpu {
-  std::unique_ptr<cpu::EmbreeScene> scene;
+  std::unique_ptr<cpu::EmbreeScene> scene;    // the CPU tracer's, or
+  std::unique_ptr<gpu::HostGpuTracer> gpu_bvh;  // the GPU's samples on this CPU
 };
 
 struct RankTracer::Gpu {
@@ -23,12 +25,14 @@ struct RankTracer::Gpu {
 #endif
 };
 
-RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options)
+RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options, bool gpu_samples)
     : scene_(scene), settings_(settings), options_(options) {
   settings_.validate();
   if (settings_.device == Device::Cpu) {
     // Built once for every chunk (a million-triangle scene takes Embree a second).
-    cpu_ = std::make_unique<Cpu>(Cpu{cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout)});
+    cpu_ = std::make_unique<Cpu>();
+    if (gpu_samples) cpu_->gpu_bvh = std::make_unique<gpu::HostGpuTracer>(scene);
+    else cpu_->scene = cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout);
   } else {
     std::string why;
     if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
@@ -40,13 +44,26 @@ RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const
 
 RankTracer::~RankTracer() = default;
 
+const char* RankTracer::tracer() const {
+  if (!cpu_) return "gpu";
+  return cpu_->gpu_bvh ? "gpu-bvh-on-host" : "embree";
+}
+
 void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
   RenderSettings s = settings_;
   s.first_sample = share.first;
   s.sample_count = share.count;
   s.progress = false;  // ranks' bars would interleave on one terminal
   RunReport chunk;
-  if (s.device == Device::Cpu) {
+  if (s.device == Device::Cpu && cpu_->gpu_bvh) {
+    if (chunks_ == 0) {  // what cpu::render reports of itself
+      chunk.settings = s;
+      chunk.threads = s.threads > 0 ? s.threads : hardware_threads();
+      chunk.extra["tracer"] = tracer();
+      chunk.extra["bvh_layout"] = cpu_->gpu_bvh->layout();
+    }
+    cpu_->gpu_bvh->render(s, film, chunk);  // Film::add accumulates into the rank's film
+  } else if (s.device == Device::Cpu) {
     cpu::render(scene_, *cpu_->scene, s, film, chunk);  // Film::add accumulates into the rank's film
   } else {
 #if PATHBENCH_HAVE_CUDA

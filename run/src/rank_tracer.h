@@ -15,8 +15,12 @@ namespace pb::run {
 class RankTracer {
  public:
   // Validates `settings`, checks the device, and on the GPU uploads the scene once.
-  // Throws InputError like run::render.
-  RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options);
+  // Throws InputError like run::render. `gpu_samples`: a CPU rank in a frame with GPU
+  // ranks traces the GPU's samples bit for bit (gpu/host_tracer.h), not Embree's, so
+  // that the image does not depend on which device took which samples.
+  RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options, bool gpu_samples = false);
+  // What traces this rank's samples: "embree", "gpu", or "gpu-bvh-on-host".
+  const char* tracer() const;
   ~RankTracer();
   // Traces samples `share` of every pixel into `film` (begun for the whole frame, and
   // holding nothing but this tracer's earlier chunks), and adds the chunk's rays, paths,
@@ -28,7 +32,7 @@ class RankTracer {
   RenderSettings settings_;
   RunOptions options_;
   Film scratch_;  // GPU: the device's film comes back whole, so later chunks land here first
-  struct Cpu;  // the Embree scene
+  struct Cpu;  // the Embree scene, or the GPU's BVH on the host
   struct Gpu;  // the uploaded scene and BVH
   std::unique_ptr<Cpu> cpu_;
   std::unique_ptr<Gpu> gpu_;

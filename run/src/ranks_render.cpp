@@ -138,7 +138,10 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     if (s.device == Device::Gpu) gpu_index = gpu::select_device(w.local_rank());
 #endif
     if (s.device == Device::Cpu && s.threads == 0) s.threads = cpu_share(local_devices);
-    tracer = std::make_unique<RankTracer>(scene, s, options);
+    // A CPU rank beside GPU ranks traces the GPU's samples, bit for bit (the hybrid's
+    // image is then one GPU's, whichever rank took which chunk).
+    const bool beside_gpus = std::find(devices.begin(), devices.end(), "gpu") != devices.end();
+    tracer = std::make_unique<RankTracer>(scene, s, options, s.device == Device::Cpu && beside_gpus);
     const bool variance = s.variance || options.keep_variance || film.has_variance();
     if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
       film = Film(s.width, s.height, variance);

@@ -17,6 +17,9 @@ nlohmann::json rank_entry(int rank, const std::string& host, const RenderSetting
           {"host", host},
           {"device", to_string(s.device)},
           {"device_name", name},
+          // What traced the samples: "gpu", "embree", or "gpu-bvh-on-host" (a CPU rank
+          // beside GPU ranks traces the GPU's samples: gpu/host_tracer.h).
+          {"tracer", gpu ? std::string("gpu") : r.extra.value("tracer", std::string("embree"))},
           {"gpu_index", gpu_index >= 0 ? nlohmann::json(gpu_index) : nlohmann::json(nullptr)},
           {"threads", gpu ? nlohmann::json(nullptr) : nlohmann::json(r.threads)},
           {"samples_per_pixel", samples_per_pixel},

@@ -12,6 +12,7 @@
 #include "pathbench/common/scene_library.h"
 #include "pathbench/gpu/bvh_build.h"
 #include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/gpu/host_tracer.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "traversal_check.h"
@@ -164,6 +165,36 @@ void gpu_vs_cpu(const char* name) {
   std::printf("[ INFO     ] %s statistical test: %s\n", name, t.summary().c_str());
   EXPECT_EQ(t.passed, t.values) << t.summary();
 #endif
+}
+
+// The GPU's samples computed on the CPU (host_tracer.h: what a CPU rank beside GPU
+// ranks traces) give the GPU's film byte for byte: the hybrid render's premise.
+void host_tracer_vs_gpu(const char* name, Sampling sampling, int bounces, Precision precision = Precision::Float) {
+  const Scene scene = load_scene(name);
+  RenderSettings s = small_settings(Strategy::Pixel, 48, 24);
+  s.sampling = sampling;
+  s.max_bounces = bounces;
+  s.precision = precision;
+  const GpuScene gs(scene);
+  const Film gpu_film = render_gpu(scene, gs, s);
+  Film host_film(s.width, s.height, false);
+  host_film.begin(s.spp, scene.max_emission());
+  RunReport r;
+  HostGpuTracer(scene).render(s, host_film, r);
+  EXPECT_EQ(r.paths, s.total_samples());
+  expect_identical(gpu_film, host_film, name);
+  EXPECT_EQ(gpu_film.counts(), host_film.counts());
+}
+
+TEST(HostGpuTracer, SameFilmAsTheGpu) {
+  PB_REQUIRE_GPU();
+  host_tracer_vs_gpu("paper-cornell", Sampling::Nee, 2);
+  host_tracer_vs_gpu("paper-cornell", Sampling::Uniform, 2);
+  host_tracer_vs_gpu("cornell-box", Sampling::Nee, -1);
+  host_tracer_vs_gpu("cornell-box:ggx", Sampling::Nee, 4);
+  host_tracer_vs_gpu("cornell-box:glass", Sampling::Cosine, 3);
+  host_tracer_vs_gpu("paper-cornell-ico:3", Sampling::Nee, 3);
+  host_tracer_vs_gpu("paper-cornell", Sampling::Nee, 2, Precision::Double);
 }
 
 TEST(GpuVsCpu, PaperCornell) {

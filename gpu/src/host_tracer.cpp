@@ -1,0 +1,62 @@
+#include "pathbench/gpu/host_tracer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <chrono>
+
+#include "pathbench/common/features.h"
+#include "pathbench/gpu/path_trace.h"
+
+namespace pb::gpu {
+
+HostGpuTracer::HostGpuTracer(const Scene& scene) : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env())) {}
+
+void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport& report) const {
+  const SceneView view = scene_.view();
+  const BvhView bvh = bvh_.view();
+  const PathConfig c = settings.path_config();
+  const uint32_t width = settings.width, height = settings.height, spp = settings.traced_spp();
+  std::atomic<uint64_t> bounce{0}, shadow{0}, discarded{0};
+  // The GPU's choice of kernel (pixel.cu's run_pixel): double precision and the
+  // Moeller-Trumbore test switch on the layout at run time, as there; the same code.
+  auto trace_rows = [&](auto kinds, auto real, auto watertight) {
+    constexpr uint32_t K = decltype(kinds)::value;
+    using T = typename decltype(real)::type;
+    constexpr bool W = decltype(watertight)::value;
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, height), [&](const tbb::blocked_range<uint32_t>& rows) {
+      uint32_t n_bounce = 0, n_shadow = 0, n_discarded = 0;
+      for (uint32_t y = rows.begin(); y < rows.end(); ++y)
+        for (uint32_t x = 0; x < width; ++x) {
+          const uint32_t pixel = y * width + x;
+          for (uint32_t k = 0; k < spp; ++k) {
+            const Vec3f L = trace_path_bvh<K, T, W, kAnyKind>(view, bvh, c, pixel, c.first_sample + k, n_bounce, n_shadow);
+            if (!film.add(pixel, L)) ++n_discarded;  // one writer per pixel: rows are split
+          }
+        }
+      bounce += n_bounce;
+      shadow += n_shadow;
+      discarded += n_discarded;
+    });
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    with_features(view.material_kinds, [&](auto kinds) {
+      if (settings.precision == Precision::Double) trace_rows(kinds, std::type_identity<double>{}, std::true_type{});
+      else if (!settings.watertight) trace_rows(kinds, std::type_identity<float>{}, std::false_type{});
+      else trace_rows(kinds, std::type_identity<float>{}, std::true_type{});
+    });
+  });
+  const uint64_t paths = uint64_t(width) * height * spp;
+  report.rays.camera += paths;
+  report.rays.bounce += bounce;
+  report.rays.shadow += shadow;
+  report.paths += paths;
+  report.discarded_samples += discarded;
+  report.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace pb::gpu

@@ -1,0 +1,85 @@
+// The GPU tracer's samples on the CPU (gpu/host_tracer.h), without a GPU: its film is
+// exact under any split of the samples and any thread count (what MPI chunks need), and
+// it renders what the CPU tracer renders (the same pixels within 1e-4, as the GPU does:
+// tests/gpu/test_gpu.cpp's GpuVsCpu). That it equals the GPU's film byte for byte is
+// HostGpuTracer.SameFilmAsTheGpu in test_gpu.cpp (label gpu).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "pathbench/common/scene_library.h"
+#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/run/run.h"
+
+namespace pb::gpu {
+namespace {
+
+RenderSettings settings(uint32_t size, uint32_t spp) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.max_bounces = 2;
+  s.sampling = Sampling::Nee;
+  s.device = Device::Cpu;
+  s.seed = 99;
+  s.progress = false;
+  return s;
+}
+
+Film host_film(const Scene& scene, const HostGpuTracer& t, const RenderSettings& s,
+               std::initializer_list<std::pair<uint32_t, uint32_t>> chunks, RunReport& r) {
+  Film f(s.width, s.height, false);
+  f.begin(s.spp, scene.max_emission());
+  for (auto [first, count] : chunks) {
+    RenderSettings c = s;
+    c.first_sample = first;
+    c.sample_count = count;
+    t.render(c, f, r);
+  }
+  return f;
+}
+
+TEST(HostGpuTracer, ExactUnderAnySplitOfSamplesAndThreads) {
+  const Scene scene = load_scene("paper-cornell");
+  const HostGpuTracer tracer(scene);
+  RenderSettings s = settings(24, 16);
+  RunReport whole_r, split_r, one_r;
+  const Film whole = host_film(scene, tracer, s, {{0, 16}}, whole_r);
+  const Film split = host_film(scene, tracer, s, {{0, 5}, {5, 1}, {6, 10}}, split_r);
+  s.threads = 1;
+  const Film one_thread = host_film(scene, tracer, s, {{0, 16}}, one_r);
+  EXPECT_EQ(whole.raw_sums(), split.raw_sums());
+  EXPECT_EQ(whole.counts(), split.counts());
+  EXPECT_EQ(whole.raw_sums(), one_thread.raw_sums());
+  EXPECT_EQ(whole_r.paths, uint64_t(24) * 24 * 16);
+  EXPECT_EQ(split_r.paths, whole_r.paths);
+  EXPECT_EQ(split_r.rays.total(), whole_r.rays.total());
+  EXPECT_GT(whole_r.rays.shadow, 0u);
+}
+
+TEST(HostGpuTracer, RendersWhatTheCpuTracerRenders) {
+  for (const char* name : {"paper-cornell", "cornell-box:ggx"}) {
+    const Scene scene = load_scene(name);
+    const RenderSettings s = settings(32, 16);
+    RunReport hr, cr;
+    const Film host = host_film(scene, HostGpuTracer(scene), s, {{0, 16}}, hr);
+    Film cpu(s.width, s.height, false);
+    run::render(scene, s, cpu, cr);
+    const auto a = host.mean(), b = cpu.mean();
+    size_t within = 0;
+    for (size_t p = 0; p < a.size() / 3; ++p) {
+      bool ok = true;
+      for (int k = 0; k < 3; ++k) {
+        const double x = a[p * 3 + k], y = b[p * 3 + k];
+        ok = ok && std::fabs(x - y) <= 1e-4 * std::max({std::fabs(x), std::fabs(y), 1e-30});
+      }
+      within += ok;
+    }
+    EXPECT_GE(double(within), 0.99 * double(a.size() / 3)) << name;
+    EXPECT_EQ(hr.paths, cr.paths) << name;
+  }
+}
+
+}  // namespace
+}  // namespace pb::gpu
