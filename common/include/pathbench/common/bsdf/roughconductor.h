@@ -12,6 +12,7 @@
 // All in the local frame (z = the normal on the incoming side); wo points away from the
 // surface towards where the ray came from.
 #include "pathbench/common/bsdf/sample.h"
+#include "pathbench/common/sampling.h"
 
 namespace pb {
 
@@ -37,10 +38,13 @@ template <class T> PB_HD Vec3<T> ggx_sample_visible_normal(T alpha, Vec3<T> wo, 
   const Vec3<T> t1 = len2 > T(0) ? Vec3<T>{-vh.y, vh.x, T(0)} * (T(1) / std::sqrt(len2)) : Vec3<T>{T(1), T(0), T(0)};
   const Vec3<T> t2 = cross(vh, t1);
   const T r = std::sqrt(u0);
-  const T phi = T(2) * kPi<T> * u1;
-  const T p1 = r * std::cos(phi);
+  // sincos_turns, not std::sin/std::cos of 2 pi u1: the CPU's libm and CUDA's sinf/cosf
+  // round differently, and the GPU's samples must be the CPU's bit for bit.
+  T sin_phi, cos_phi;
+  sincos_turns(u1, sin_phi, cos_phi);
+  const T p1 = r * cos_phi;
   const T s = T(0.5) * (T(1) + vh.z);
-  const T p2 = (T(1) - s) * std::sqrt(pmax(T(0), T(1) - p1 * p1)) + s * (r * std::sin(phi));
+  const T p2 = (T(1) - s) * std::sqrt(pmax(T(0), T(1) - p1 * p1)) + s * (r * sin_phi);
   const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * std::sqrt(pmax(T(0), T(1) - p1 * p1 - p2 * p2));
   return normalize(Vec3<T>{alpha * nh.x, alpha * nh.y, pmax(T(0), nh.z)});
 }
