@@ -19,7 +19,7 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
 # (PATHBENCH_MPI=OFF: the mpi label is not run here, OpenMPI's own allocations would read
 # as leaks; the unit and CLI tests run the one-rank world, run/src/single_world.cpp.)
 cmake --build build-asan --parallel "$(nproc)" --target pathbench pathbench_unit_tests pathbench_bench_tests \
-  pathbench_traversal_tests fuzz_scene_json_replay fuzz_obj_replay fuzz_bench_json_replay fuzz_ply_replay \
+  pathbench_traversal_tests pathbench_host_tracer_tests fuzz_scene_json_replay fuzz_obj_replay fuzz_bench_json_replay fuzz_ply_replay \
   fuzz_gltf_replay fuzz_mitsuba_replay
 # Leaks are errors; TBB's and Embree's process-lifetime allocations are not ours.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
