@@ -3,9 +3,11 @@
 #include <embree3/rtcore.h>
 
 #include <limits>
+#include <type_traits>
 
 #include "pathbench/common/camera.h"
 #include "pathbench/cpu/embree_scene.h"
+#include "shade_batch.h"
 
 namespace pb::cpu {
 
@@ -81,6 +83,23 @@ template <int W> void init_packet_constants(RTCRayNt<W>& r) {
 template <int W> inline uint32_t packet_triangle(const EmbreeScene& e, const RTCRayHitNt<W>& p, int i) {
   return p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID
                                                     : e.triangle(p.hit.primID[i], p.hit.u[i], p.hit.v[i]);
+}
+
+// The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
+// are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W;
+// lanes from n on repeat slot 0); false (nothing done) without kernels or for double
+// records, which the caller converts lane by lane (set_lane).
+template <int W, class Record, class Index>
+bool rays_to_packet(const BatchKernels* k, const Record* records, const Index* slots, int n, RTCRayNt<W>& r) {
+  if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
+    if (!k) return false;
+    const void* rows[W];
+    for (int i = 0; i < W; ++i) rows[i] = &records[slots[i < n ? i : 0]];
+    float* const out[6] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z};
+    k->rays_to_packet(rows, out);
+    return true;
+  }
+  return false;
 }
 
 }  // namespace pb::cpu

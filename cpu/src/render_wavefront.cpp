@@ -54,24 +54,6 @@ namespace {
 // the same Embree kernel at the same instruction count there.)
 // (intersect_packet, occluded_packet: embree_rays.h.)
 
-// The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
-// are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W);
-// false (nothing done) without kernels or for double records, which the caller
-// converts lane by lane (set_lane).
-template <int W, class Record>
-bool rays_to_packet(const BatchKernels* k, const std::vector<Record>& records, const uint32_t* slots, int n,
-                    RTCRayNt<W>& r) {
-  if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
-    if (!k) return false;
-    const void* rows[W];
-    for (int i = 0; i < W; ++i) rows[i] = &records[slots[i < n ? i : 0]];
-    float* const out[6] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z};
-    k->rays_to_packet(rows, out);
-    return true;
-  }
-  return false;
-}
-
 // One thread's slice and the stages over it, in scalar type T, compiled for the material
 // kinds `Kinds` (features.h), with packets of W rays; `k` (width W) and `table` where the
 // batched path step runs (diffuse-only float, a vector ISA), `tiny` where the tiny-scene
@@ -227,7 +209,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
   // is unsure.
   void closest(const uint32_t* slots, int n, uint32_t* prim) {
     RTCRayHitNt<W>& p = hit_packet_;
-    const bool filled = rays_to_packet<W>(k_, pool_.state, slots, n, p.ray);
+    const bool filled = rays_to_packet<W>(k_, pool_.state.data(), slots, n, p.ray);
     for (int i = 0; i < W; ++i) {
       if (i < n && !filled) set_lane(p.ray, i, pool_.state[slots[i]].ray, kInfinity);
       p.ray.tfar[i] = kInfinity;
@@ -308,7 +290,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
     n_shadow_ = 0;
     const uint32_t* slots = shadow_slot_;
     RTCRayNt<W>& p = shadow_packet_;
-    const bool filled = rays_to_packet<W>(k_, pool_.shadow, slots, n, p);
+    const bool filled = rays_to_packet<W>(k_, pool_.shadow.data(), slots, n, p);
     for (int i = 0; i < W; ++i) {
       if (i < n && !filled) set_lane(p, i, pool_.shadow[slots[i]].ray, 1.0f);
       p.tfar[i] = 1.0f;
