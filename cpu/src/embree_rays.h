@@ -79,6 +79,20 @@ template <int W> void init_packet_constants(RTCRayNt<W>& r) {
   }
 }
 
+// A packet's per-call fields at their start values: tfar (infinity for closest hits, 1 for
+// shadow rays, whose direction spans the segment) and the hit's geomID. Only Embree changes
+// them, so a tracer that keeps its packets resets them after each Embree call, not before
+// every call (the tiny-scene test reads tfar and leaves it).
+template <int W> void reset_packet(RTCRayHitNt<W>& p) {
+  for (int i = 0; i < W; ++i) {
+    p.ray.tfar[i] = kInfinity;
+    p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+  }
+}
+template <int W> void reset_packet(RTCRayNt<W>& p) {
+  for (int i = 0; i < W; ++i) p.tfar[i] = 1.0f;
+}
+
 // The scene triangle a packet's lane i hit (after intersect_packet), or RTC_INVALID_GEOMETRY_ID.
 template <int W> inline uint32_t packet_triangle(const EmbreeScene& e, const RTCRayHitNt<W>& p, int i) {
   return p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID

@@ -62,13 +62,16 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
 }
 
 // One thread's packets for the batched samples (W = the kernels' width): the fields
-// that never change (tnear, time, mask, id, flags) are set once per tile, not per call.
+// that never change (tnear, time, mask, id, flags) are set once per tile, not per call,
+// and tfar / geomID are put back only where Embree changed them (reset_packet).
 template <int W> struct PixelPackets {
   alignas(64) RTCRayHitNt<W> hit;
   alignas(64) RTCRayNt<W> shadow;
   PixelPackets() {
     init_packet_constants(hit.ray);
     init_packet_constants(shadow);
+    reset_packet(hit);
+    reset_packet(shadow);
   }
 };
 
@@ -77,34 +80,31 @@ template <int W> struct PixelPackets {
 template <int W>
 void closest_packet(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
                     RTCRayHitNt<W>& p, const PathState<float>* st, const int* idx, int n, uint32_t* prim) {
-  rays_to_packet<W>(&k, st, idx, n, p.ray);
-  for (int j = 0; j < W; ++j) {
-    p.ray.tfar[j] = kInfinity;
-    p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
-  }
+  rays_to_packet<W>(&k, st, idx, n, p.ray);  // tfar, geomID: at their start values (PixelPackets)
   if (tiny) {
-    tiny_closest<W>(k, *tiny, e, ctx, p, n, prim);
+    if (tiny_closest<W>(k, *tiny, e, ctx, p, n, prim) > 0) reset_packet(p);
     return;
   }
   alignas(64) int valid[W];
   for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
   intersect_packet(valid, e.handle(), &ctx, p);
   for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
+  reset_packet(p);
 }
 // Whether each shadow ray q[idx[0..n)] (n <= W) is blocked, as one packet.
 template <int W>
 void occluded_packet_of(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
                         RTCRayNt<W>& p, const ShadowQuery<float>* q, const int* idx, int n, bool* blocked) {
-  rays_to_packet<W>(&k, q, idx, n, p);
-  for (int j = 0; j < W; ++j) p.tfar[j] = 1.0f;
+  rays_to_packet<W>(&k, q, idx, n, p);  // tfar: 1 (PixelPackets)
   if (tiny) {
-    tiny_occluded<W>(k, *tiny, e, ctx, p, n, blocked);
+    if (tiny_occluded<W>(k, *tiny, e, ctx, p, n, blocked) > 0) reset_packet(p);
     return;
   }
   alignas(64) int valid[W];
   for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
   occluded_packet(valid, e.handle(), &ctx, p);
   for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
+  reset_packet(p);
 }
 
 // Diffuse-only float renders with a vector ISA (batched_shading_table): up to W = k.lanes

@@ -69,6 +69,8 @@ template <class T, uint32_t Kinds, int W> class Slice {
       final_depth_ = uint32_t(job.config.max_bounces);
     init_packet_constants(hit_packet_.ray);
     init_packet_constants(shadow_packet_);
+    reset_packet(hit_packet_);
+    reset_packet(shadow_packet_);
   }
 
   void run() {
@@ -216,19 +218,18 @@ template <class T, uint32_t Kinds, int W> class Slice {
   void closest(const uint32_t* slots, int n, uint32_t* prim) {
     RTCRayHitNt<W>& p = hit_packet_;
     const bool filled = rays_to_packet<W>(k_, pool_.state.data(), slots, n, p.ray);
-    for (int i = 0; i < W; ++i) {
-      if (i < n && !filled) set_lane(p.ray, i, pool_.state[slots[i]].ray, kInfinity);
-      p.ray.tfar[i] = kInfinity;
-      p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-    }
+    if (!filled)
+      for (int i = 0; i < n; ++i) set_lane(p.ray, i, pool_.state[slots[i]].ray, kInfinity);
+    // tfar and geomID hold their start values here (reset_packet after each Embree call).
     if (tiny_ && filled) {
-      tiny_closest<W>(*k_, *tiny_, job_.embree, ctx_, p, n, prim);
+      if (tiny_closest<W>(*k_, *tiny_, job_.embree, ctx_, p, n, prim) > 0) reset_packet(p);
       return;
     }
     alignas(64) int valid[W];
     for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
     intersect_packet(valid, job_.embree.handle(), &ctx_, p);
     for (int i = 0; i < n; ++i) prim[i] = packet_triangle(job_.embree, p, i);
+    reset_packet(p);
   }
 
   // A packet's hits into the shading batch (as shade() does, with the pool's pointers and
@@ -312,18 +313,17 @@ template <class T, uint32_t Kinds, int W> class Slice {
     const uint32_t* slots = shadow_slot_;
     RTCRayNt<W>& p = shadow_packet_;
     const bool filled = rays_to_packet<W>(k_, pool_.shadow.data(), slots, n, p);
-    for (int i = 0; i < W; ++i) {
-      if (i < n && !filled) set_lane(p, i, pool_.shadow[slots[i]].ray, 1.0f);
-      p.tfar[i] = 1.0f;
-    }
-    bool blocked[W];
+    if (!filled)
+      for (int i = 0; i < n; ++i) set_lane(p, i, pool_.shadow[slots[i]].ray, 1.0f);
+    bool blocked[W];  // tfar holds 1 here (reset_packet after each Embree call)
     if (tiny_ && filled) {
-      tiny_occluded<W>(*k_, *tiny_, job_.embree, ctx_, p, n, blocked);
+      if (tiny_occluded<W>(*k_, *tiny_, job_.embree, ctx_, p, n, blocked) > 0) reset_packet(p);
     } else {
       alignas(64) int valid[W];
       for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
       occluded_packet(valid, job_.embree.handle(), &ctx_, p);
       for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
+      reset_packet(p);
     }
     for (int i = 0; i < n; ++i) {
       const uint32_t slot = slots[i];
