@@ -193,8 +193,10 @@ template <class T, uint32_t Kinds, int W> class Slice {
     closest_ += n_live;
     for (uint32_t base = 0; base < n_live; base += W) {
       const int n = int(std::min<uint32_t>(W, n_live - base));
-      uint32_t slots[W], prim[W];
-      for (int i = 0; i < n; ++i) slots[i] = pool_.live[base + uint32_t(i)];
+      // Read in place: routing writes `live` only below the paths routed so far, all of
+      // which were read before (lane i's slot is read before any path after it is routed).
+      const uint32_t* slots = &pool_.live[base];
+      uint32_t prim[W];
       closest(slots, n, prim);
       if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
         if (table_) {
