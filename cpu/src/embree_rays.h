@@ -3,9 +3,11 @@
 #include <embree3/rtcore.h>
 
 #include <limits>
+#include <type_traits>
 
 #include "pathbench/common/camera.h"
 #include "pathbench/cpu/embree_scene.h"
+#include "shade_batch.h"
 
 namespace pb::cpu {
 
@@ -77,10 +79,41 @@ template <int W> void init_packet_constants(RTCRayNt<W>& r) {
   }
 }
 
+// A packet's per-call fields at their start values: tfar (infinity for closest hits, 1 for
+// shadow rays, whose direction spans the segment) and the hit's geomID. Only Embree changes
+// them, so a tracer that keeps its packets resets them after each Embree call, not before
+// every call (the tiny-scene test reads tfar and leaves it).
+template <int W> void reset_packet(RTCRayHitNt<W>& p) {
+  for (int i = 0; i < W; ++i) {
+    p.ray.tfar[i] = kInfinity;
+    p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+  }
+}
+template <int W> void reset_packet(RTCRayNt<W>& p) {
+  for (int i = 0; i < W; ++i) p.tfar[i] = 1.0f;
+}
+
 // The scene triangle a packet's lane i hit (after intersect_packet), or RTC_INVALID_GEOMETRY_ID.
 template <int W> inline uint32_t packet_triangle(const EmbreeScene& e, const RTCRayHitNt<W>& p, int i) {
   return p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID
                                                     : e.triangle(p.hit.primID[i], p.hit.u[i], p.hit.v[i]);
+}
+
+// The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
+// are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W;
+// lanes from n on repeat slot 0); false (nothing done) without kernels or for double
+// records, which the caller converts lane by lane (set_lane).
+template <int W, class Record, class Index>
+bool rays_to_packet(const BatchKernels* k, const Record* records, const Index* slots, int n, RTCRayNt<W>& r) {
+  if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
+    if (!k) return false;
+    const void* rows[W];
+    for (int i = 0; i < W; ++i) rows[i] = &records[slots[i < n ? i : 0]];
+    float* const out[6] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z};
+    k->rays_to_packet(rows, out);
+    return true;
+  }
+  return false;
 }
 
 }  // namespace pb::cpu

@@ -3,9 +3,10 @@
 // render_pixel_all_kinds.cpp. The diffuse-only code is then compiled exactly as in a
 // build without the other kinds (the compiler's inlining budget is per translation unit).
 // Every sample is one path traced with single rays (rtcIntersect1 / rtcOccluded1); for
-// diffuse-only float renders with a vector ISA (--isa) the path steps of up to 16
-// (AVX-512) or 8 (AVX2) samples of a pixel run together, a vector wide
-// (trace_samples_batched), bit-identical to trace_path.
+// diffuse-only float renders with a vector ISA (--isa) up to 16 (AVX-512) or 8 (AVX2)
+// samples of a pixel run together, a vector wide, their rays as one packet
+// (trace_samples_batched; single rays there measured 8.8% more instructions:
+// notes/cpu-performance.md), bit-identical to trace_path.
 #include <tbb/blocked_range2d.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
@@ -60,141 +61,123 @@ PB_CPU_FLATTEN Vec3f trace_path(const TraceJob& job, RTCIntersectContext& ctx, u
   return Vec3f(st.L);
 }
 
-// Whether the batched samples' closest-hit and shadow rays go to Embree as one packet of
-// the batch's width (rtcIntersect8/16, rtcOccluded8/16) instead of one rtcIntersect1 /
-// rtcOccluded1 each (notes/cpu-performance.md measures both).
-constexpr bool kPixelPackets = true;
+// One thread's packets for the batched samples (W = the kernels' width): the fields
+// that never change (tnear, time, mask, id, flags) are set once per tile, not per call,
+// and tfar / geomID are put back only where Embree changed them (reset_packet).
+template <int W> struct PixelPackets {
+  alignas(64) RTCRayHitNt<W> hit;
+  alignas(64) RTCRayNt<W> shadow;
+  PixelPackets() {
+    init_packet_constants(hit.ray);
+    init_packet_constants(shadow);
+    reset_packet(hit);
+    reset_packet(shadow);
+  }
+};
 
-// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet; with `tiny`, the
-// tiny-scene test first (tiny_scene.h).
+// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet (rays by the
+// kernels' transpose); with `tiny`, the tiny-scene test first (tiny_scene.h).
 template <int W>
 void closest_packet(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
-                    const PathState<float>* st, const int* idx, int n, uint32_t* prim) {
-  alignas(64) RTCRayHitNt<W> p;
-  alignas(64) int valid[W];
-  for (int j = 0; j < W; ++j) {
-    valid[j] = j < n ? -1 : 0;
-    set_lane(p.ray, j, st[idx[j < n ? j : 0]].ray, kInfinity);
-    p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
-  }
+                    RTCRayHitNt<W>& p, const PathState<float>* st, const int* idx, int n, uint32_t* prim) {
+  rays_to_packet<W>(&k, st, idx, n, p.ray);  // tfar, geomID: at their start values (PixelPackets)
   if (tiny) {
-    tiny_closest<W>(k, *tiny, e, ctx, p, n, prim);
+    if (tiny_closest<W>(k, *tiny, e, ctx, p, n, prim) > 0) reset_packet(p);
     return;
   }
+  alignas(64) int valid[W];
+  for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
   intersect_packet(valid, e.handle(), &ctx, p);
   for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
+  reset_packet(p);
 }
 // Whether each shadow ray q[idx[0..n)] (n <= W) is blocked, as one packet.
 template <int W>
 void occluded_packet_of(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
-                        const ShadowQuery<float>* q, const int* idx, int n, bool* blocked) {
-  alignas(64) RTCRayNt<W> p;
-  alignas(64) int valid[W];
-  for (int j = 0; j < W; ++j) {
-    valid[j] = j < n ? -1 : 0;
-    set_lane(p, j, q[idx[j < n ? j : 0]].ray, 1.0f);
-  }
+                        RTCRayNt<W>& p, const ShadowQuery<float>* q, const int* idx, int n, bool* blocked) {
+  rays_to_packet<W>(&k, q, idx, n, p);  // tfar: 1 (PixelPackets)
   if (tiny) {
-    tiny_occluded<W>(k, *tiny, e, ctx, p, n, blocked);
+    if (tiny_occluded<W>(k, *tiny, e, ctx, p, n, blocked) > 0) reset_packet(p);
     return;
   }
+  alignas(64) int valid[W];
+  for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
   occluded_packet(valid, e.handle(), &ctx, p);
   for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
+  reset_packet(p);
 }
 
-// Diffuse-only float renders with a vector ISA (batched_shading_table): up to k.lanes
-// samples of one pixel at a time, each traced as its own path with single rays
-// (rtcIntersect1 / rtcOccluded1, in trace_path's order), their path steps run together
-// k.lanes wide (shade_x8.h). Every path gets what trace_path would give it, bit for bit.
+// Diffuse-only float renders with a vector ISA (batched_shading_table): up to W = k.lanes
+// samples of one pixel at a time, each its own path, traced together: their rays as one
+// packet of W (closest hits, then shadow rays), their path steps run together W wide
+// (shade_x8.h). Every path gets what trace_path would give it, bit for bit.
+// The live samples always share one depth (each vertex moves every one of them on by
+// one), so the last-vertex test and the ray counts are per batch, not per lane.
+template <int W>
 PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table,
-                                          const TinyScene* tiny, RTCIntersectContext& ctx, uint32_t pixel, uint32_t first_sample, int count,
-                                          Local& local) {
-  const int width = k.lanes;
-  alignas(64) PathState<float> st[kMaxShadeLanes];
-  ShadowQuery<float> q[kMaxShadeLanes];
-  PathState<float>* lanes[kMaxShadeLanes];
-  uint32_t pixels[kMaxShadeLanes], samples[kMaxShadeLanes];
-  for (int i = 0; i < width; ++i) {
+                                          const TinyScene* tiny, RTCIntersectContext& ctx, PixelPackets<W>& packets,
+                                          uint32_t pixel, uint32_t first_sample, int count, Local& local) {
+  alignas(64) PathState<float> st[W];
+  ShadowQuery<float> q[W];
+  PathState<float>* lanes[W];
+  uint32_t pixels[W], samples[W];
+  for (int i = 0; i < W; ++i) {
     lanes[i] = &st[i < count ? i : 0];
     pixels[i] = pixel;
     samples[i] = first_sample + uint32_t(i < count ? i : 0);
   }
   k.begin_paths(job.scene, job.config, pixels, samples, lanes, count);
-  auto occlusion_test = [&](int i, uint64_t RayCounts::*kind) {
-    count_ray(local.rays, st[i].depth, kind);
-    if (!occluded(job.embree, ctx, q[i].ray, 1.0f)) shadow_unoccluded(st[i], q[i]);
-  };
-  int live[kMaxShadeLanes], n_live = count;
+  int live[W], n_live = count;
   for (int i = 0; i < count; ++i) live[i] = i;
   while (n_live > 0) {
-    // Paths at their last vertex: the emitter screen, then path_final_query (trace_path's first step).
-    PathState<float>* at_final[kMaxShadeLanes];
-    int final_lane[kMaxShadeLanes], n_final = 0, keep = 0;
-    for (int k = 0; k < n_live; ++k) {
-      const int i = live[k];
-      if (path_at_final_vertex(job.scene, job.config, st[i])) {
-        final_lane[n_final] = i;
-        at_final[n_final++] = &st[i];
-      } else {
-        live[keep++] = i;
-      }
-    }
-    n_live = keep;
-    if (n_final > 0) {
-      for (int j = n_final; j < width; ++j) at_final[j] = at_final[0];
-      bool candidate[kMaxShadeLanes];
+    const uint32_t depth = st[live[0]].depth;  // every live sample's
+    if (path_at_final_vertex(job.scene, job.config, st[live[0]])) {
+      // The emitter screen, then path_final_query (trace_path's first step); the paths end.
+      PathState<float>* at_final[W];
+      for (int j = 0; j < W; ++j) at_final[j] = &st[live[j < n_live ? j : 0]];
+      bool candidate[W];
       k.final_vertex_candidates(job.scene, at_final, candidate);
-      for (int j = 0; j < n_final; ++j) {
-        const int i = final_lane[j];
-        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, st[i], q[i]))
-          occlusion_test(i, &RayCounts::shadow);
+      for (int j = 0; j < n_live; ++j) {
+        const int i = live[j];
+        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, st[i], q[i])) {
+          count_ray(local.rays, depth, &RayCounts::shadow);
+          if (!occluded(job.embree, ctx, q[i].ray, 1.0f)) shadow_unoccluded(st[i], q[i]);
+        }
       }
+      break;
     }
-    if (n_live == 0) break;
-    // Closest hits (one packet, or one ray at a time); misses end their paths.
-    uint32_t hit[kMaxShadeLanes];
-    if (kPixelPackets) {
-      if (width == 16) closest_packet<16>(job.embree, k, tiny, ctx, st, live, n_live, hit);
-      else closest_packet<8>(job.embree, k, tiny, ctx, st, live, n_live, hit);
-    }
+    // Closest hits (one packet); misses end their paths.
+    uint32_t hit[W];
+    closest_packet<W>(job.embree, k, tiny, ctx, packets.hit, st, live, n_live, hit);
+    (depth == 0 ? local.rays.camera : local.rays.bounce) += uint64_t(n_live);
     ShadeBatch batch;
     batch.lanes = 0;
     for (int j = 0; j < n_live; ++j) {
       const int i = live[j];
-      const uint32_t prim = kPixelPackets ? hit[j] : closest_triangle(job.embree, ctx, st[i].ray);
-      count_ray(local.rays, st[i].depth, &RayCounts::bounce);
-      if (prim == RTC_INVALID_GEOMETRY_ID) continue;
+      if (hit[j] == RTC_INVALID_GEOMETRY_ID) continue;
       batch.st[batch.lanes] = &st[i];
       batch.shadow[batch.lanes] = &q[i];
-      batch.prim[batch.lanes] = prim;
+      batch.prim[batch.lanes] = hit[j];
       live[batch.lanes++] = i;
     }
     n_live = batch.lanes;
     if (n_live == 0) break;
-    for (int j = n_live; j < width; ++j) {
+    for (int j = n_live; j < W; ++j) {
       batch.st[j] = batch.st[0];
       batch.shadow[j] = batch.shadow[0];
       batch.prim[j] = batch.prim[0];
     }
     k.shade_diffuse(job.scene, job.config, table, batch);
-    keep = 0;
-    int shadowed[kMaxShadeLanes], n_shadowed = 0;
+    int keep = 0, shadowed[W], n_shadowed = 0;
     for (int j = 0; j < n_live; ++j) {
       const int i = live[j];
-      if (batch.wants_shadow[j]) {
-        if (kPixelPackets) {
-          count_ray(local.rays, st[i].depth, &RayCounts::shadow);
-          shadowed[n_shadowed++] = i;
-        } else {
-          occlusion_test(i, &RayCounts::shadow);
-        }
-      }
+      if (batch.wants_shadow[j]) shadowed[n_shadowed++] = i;
       if (batch.cont[j]) live[keep++] = i;
     }
     if (n_shadowed > 0) {
-      bool blocked[kMaxShadeLanes];
-      if (width == 16) occluded_packet_of<16>(job.embree, k, tiny, ctx, q, shadowed, n_shadowed, blocked);
-      else occluded_packet_of<8>(job.embree, k, tiny, ctx, q, shadowed, n_shadowed, blocked);
+      local.rays.shadow += uint64_t(n_shadowed);  // depth >= 0 here: never a camera ray
+      bool blocked[W];
+      occluded_packet_of<W>(job.embree, k, tiny, ctx, packets.shadow, q, shadowed, n_shadowed, blocked);
       for (int j = 0; j < n_shadowed; ++j)
         if (!blocked[j]) shadow_unoccluded(st[shadowed[j]], q[shadowed[j]]);
     }
@@ -204,6 +187,18 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     ++local.paths;
     if (!job.film.add(pixel, Vec3f(st[i].L))) ++local.discarded;
   }
+}
+
+// The samples of every pixel of a tile, W at a time.
+template <int W>
+void trace_tile_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table, const TinyScene* tiny,
+                        RTCIntersectContext& ctx, const tbb::blocked_range2d<uint32_t>& tile, Local& local) {
+  PixelPackets<W> packets;
+  for (uint32_t y = tile.rows().begin(); y < tile.rows().end(); ++y)
+    for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x)
+      for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; s += W)
+        trace_samples_batched<W>(job, k, table, tiny, ctx, packets, y * job.config.width + x, s,
+                                 int(std::min<uint32_t>(W, end - s)), local);
 }
 
 template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& job) {
@@ -216,21 +211,20 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
     Local& local = locals.local();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    for (uint32_t y = tile.rows().begin(); y < tile.rows().end(); ++y)
-      for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
-        const uint32_t pixel = y * w + x;
-        if (table) {
-          const uint32_t width = uint32_t(k->lanes);
-          for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; s += width)
-            trace_samples_batched(job, *k, *table, tiny.get(), ctx, pixel, s, int(std::min<uint32_t>(width, end - s)), local);
-          continue;
+    if (table) {
+      if (k->lanes == 16) trace_tile_batched<16>(job, *k, *table, tiny.get(), ctx, tile, local);
+      else trace_tile_batched<8>(job, *k, *table, tiny.get(), ctx, tile, local);
+    } else {
+      for (uint32_t y = tile.rows().begin(); y < tile.rows().end(); ++y)
+        for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
+          const uint32_t pixel = y * w + x;
+          for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; ++s) {
+            Vec3f L = trace_path<T, Kinds>(job, ctx, pixel, s, local);
+            ++local.paths;
+            if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here
+          }
         }
-        for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; ++s) {
-          Vec3f L = trace_path<T, Kinds>(job, ctx, pixel, s, local);
-          ++local.paths;
-          if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here
-        }
-      }
+    }
     job.progress.advance(uint64_t(tile.rows().size()) * tile.cols().size() * job.spp);
   });
   TraceTotals t;

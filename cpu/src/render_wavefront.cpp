@@ -1,9 +1,17 @@
 // Ray-parallel ("wavefront") CPU strategy. Each thread owns a slice of the pool of
-// paths in flight and runs the stages over the whole slice in turn:
+// paths in flight and runs, per round:
 //   generate (fill free slots with new samples) -> final vertex (paths whose next hit
-//   can only add emission: emitter query instead of a closest hit) -> intersect (packets
-//   of W rays) -> shade (shared path step) -> shadow (packets of W) -> accumulate
+//   can only add emission: emitter query instead of a closest hit) -> one pass over the
+//   live paths: closest hits (packets of W rays), shading (the shared path step), shadow
+//   rays (packets of W, traced as soon as W are waiting), and the film for paths that end
 // Memory is the pool, fixed by --paths-in-flight, never width x height x spp.
+// The pass is one loop, not a stage per list: a packet's hits go straight into the
+// shading batch, shading routes each path at once (on in `live`, compacted in place; to
+// `final`; ended: to the film and `free`), so no list is rebuilt and no path is looked
+// at twice per round (cpu/NOTES.md, "Item 5, queue management", measures it). Per path
+// the order stays the path step's: a vertex's shadow ray is answered before the path's
+// next vertex is shaded (every pending shadow packet is traced by the end of the pass).
+// The film sums are integers, so the order in which paths reach it does not matter.
 // Diffuse-only float renders with a vector ISA (--isa; the paper's benchmark) run
 // generate, final vertex and shade a vector's width of paths at a time (BatchKernels,
 // shade_x8.h: the path step's arithmetic lane-wise in its own order, so the image stays
@@ -18,6 +26,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <type_traits>
 #include <unistd.h>
@@ -45,261 +54,315 @@ namespace {
 // the same Embree kernel at the same instruction count there.)
 // (intersect_packet, occluded_packet: embree_rays.h.)
 
-// With kernels `k` (float, a vector ISA) k->lanes new paths at a time (begin_paths).
-template <class T>
-PB_CPU_FLATTEN void stage_generate(const TraceJob& job, const BatchKernels* k, SampleSource& src, PoolSlice<T>& pool) {
-  uint64_t n = pool.free.size();
-  if (n == 0) return;
-  const uint64_t start = src.claim(n);
-  uint64_t i = 0;
-  if constexpr (std::is_same_v<T, float>) {
-    if (k) {
-      const int width = k->lanes;
-      for (; i < n; i += uint64_t(width)) {
-        const int lanes = int(std::min<uint64_t>(uint64_t(width), n - i));
-        uint32_t pixel[kMaxShadeLanes], sample[kMaxShadeLanes];
-        PathState<float>* st[kMaxShadeLanes];
-        for (int l = 0; l < width; ++l) {
-          const uint64_t g = start + i + uint64_t(l < lanes ? l : 0);
-          pixel[l] = src.pixel_of(g);
-          sample[l] = src.sample_of(g);
-          if (l < lanes) {
-            st[l] = &pool.state[pool.free.back()];
-            pool.live.push_back(pool.free.back());
-            pool.free.pop_back();
-          } else {
+// One thread's slice and the stages over it, in scalar type T, compiled for the material
+// kinds `Kinds` (features.h), with packets of W rays; `k` (width W) and `table` where the
+// batched path step runs (diffuse-only float, a vector ISA), `tiny` where the tiny-scene
+// test answers first (tiny_scene.h).
+template <class T, uint32_t Kinds, int W> class Slice {
+ public:
+  Slice(const TraceJob& job, const BatchKernels* k, const ShadeTable* table, const TinyScene* tiny, SampleSource& src,
+        size_t paths, Local& local)
+      : job_(job), k_(k), table_(table), tiny_(tiny), src_(src), pool_(paths), local_(local) {
+    rtcInitIntersectContext(&ctx_);
+    // path_at_final_vertex as one compare of the depth.
+    if (job.config.max_bounces >= 0 && job.scene.num_emitters <= kMaxEmittersForFinalQuery)
+      final_depth_ = uint32_t(job.config.max_bounces);
+    init_packet_constants(hit_packet_.ray);
+    init_packet_constants(shadow_packet_);
+    reset_packet(hit_packet_);
+    reset_packet(shadow_packet_);
+  }
+
+  void run() {
+    for (;;) {
+      generate();
+      if (pool_.n_live == 0 && pool_.n_final == 0) break;
+      finished_ = 0;
+      final_vertex();
+      trace_live();
+      if (n_shadow_ > 0) trace_shadows();
+      local_.paths += finished_;
+      job_.progress.advance(finished_);
+    }
+    // Every closest-hit query of a depth-0 path is its camera ray (count_ray).
+    local_.rays.camera += camera_;
+    local_.rays.bounce += closest_ - camera_;
+  }
+
+ private:
+  // Free slots get new samples: `live`, or `final` where a path's first vertex is its last.
+  PB_CPU_FLATTEN void generate() {
+    uint64_t n = pool_.n_free;
+    if (n == 0) return;
+    const uint64_t start = src_.claim(n);
+    if (n == 0) return;
+    const bool at_final = final_depth_ == 0;
+    std::vector<uint32_t>& to = at_final ? pool_.final : pool_.live;
+    uint32_t& count = at_final ? pool_.n_final : pool_.n_live;
+    if (!at_final) camera_ += n;
+    uint32_t pixel = src_.pixel_of(start), sample = src_.sample_of(start);
+    const uint32_t pixels = src_.pixels();
+    auto next = [&] {  // (pixel, sample) of the next global index, without a division
+      if (++pixel == pixels) {
+        pixel = 0;
+        ++sample;
+      }
+    };
+    uint32_t* free = pool_.free.data();
+    uint32_t n_free = pool_.n_free, out = count;
+    if constexpr (std::is_same_v<T, float>) {
+      if (k_) {
+        const int width = k_->lanes;
+        for (uint64_t i = 0; i < n; i += uint64_t(width)) {
+          const int lanes = int(std::min<uint64_t>(uint64_t(width), n - i));
+          uint32_t px[kMaxShadeLanes], smp[kMaxShadeLanes];
+          PathState<float>* st[kMaxShadeLanes];
+          for (int l = 0; l < lanes; ++l) {
+            px[l] = pixel;
+            smp[l] = sample;
+            next();
+            const uint32_t slot = free[--n_free];
+            st[l] = &pool_.state[slot];
+            to[out++] = slot;
+          }
+          for (int l = lanes; l < width; ++l) {  // idle lanes repeat lane 0 and store nothing
+            px[l] = px[0];
+            smp[l] = smp[0];
             st[l] = st[0];
           }
+          k_->begin_paths(job_.scene, job_.config, px, smp, st, lanes);
         }
-        k->begin_paths(job.scene, job.config, pixel, sample, st, lanes);
+        pool_.n_free = n_free;
+        count = out;
+        return;
       }
-      return;
     }
+    for (uint64_t i = 0; i < n; ++i, next()) {
+      const uint32_t slot = free[--n_free];
+      path_begin(job_.scene, job_.config, pixel, sample, pool_.state[slot]);
+      to[out++] = slot;
+    }
+    pool_.n_free = n_free;
+    count = out;
   }
-  for (; i < n; ++i) {
-    const uint32_t slot = pool.free.back();
-    pool.free.pop_back();
-    path_begin(job.scene, job.config, src.pixel_of(start + i), src.sample_of(start + i), pool.state[slot]);
-    pool.live.push_back(slot);
-  }
-}
 
-// Paths whose next hit could only add emitted light leave the live list here: their
-// occlusion test (if they face an emitter) joins the shadow stage, and they are done.
-// With kernels `k` (float, a vector ISA: see batched_shading_table) k->lanes paths at a
-// time are first screened for an emitter along their ray (shade_x8.h); the scalar query
-// runs only for the lanes that may have one, and gives every path what it would have
-// given it anyway.
-template <class T, uint32_t Kinds>
-PB_CPU_FLATTEN void stage_final_vertex(const TraceJob& job, const BatchKernels* k, PoolSlice<T>& pool, Local& local) {
-  auto final_query = [&](uint32_t slot) {
-    const PathState<T>& st = pool.state[slot];
-    if (path_final_query<Kinds>(job.scene, job.config, st, pool.shadow[slot])) {
-      pool.shadowed.push_back(slot);
-      count_ray(local.rays, st.depth, &RayCounts::shadow);
-    }
-    pool.done.push_back(slot);
-  };
-  PathState<float>* lanes[kMaxShadeLanes];
-  uint32_t lane_slots[kMaxShadeLanes];
-  int n = 0;
-  auto flush = [&] {
+  // The paths in `final`: their emitter query (path_final_query); an occlusion test
+  // where one faces the ray; then they are done. With kernels, k->lanes paths at a time
+  // are first screened for an emitter along their ray (shade_x8.h); the scalar query
+  // runs only for the lanes that may have one, and gives every path what it would have
+  // given it anyway.
+  PB_CPU_FLATTEN void final_vertex() {
+    const uint32_t n = pool_.n_final;
+    pool_.n_final = 0;
+    auto query = [&](uint32_t slot) {
+      const PathState<T>& st = pool_.state[slot];
+      if (path_final_query<Kinds>(job_.scene, job_.config, st, pool_.shadow[slot])) {
+        count_ray(local_.rays, st.depth, &RayCounts::shadow);
+        queue_shadow(slot, true);
+      } else {
+        finish(slot);
+      }
+    };
+    const uint32_t* slots = pool_.final.data();
     if constexpr (std::is_same_v<T, float>) {
-      for (int i = n; i < k->lanes; ++i) lanes[i] = lanes[0];
-      bool candidate[kMaxShadeLanes];
-      k->final_vertex_candidates(job.scene, lanes, candidate);
-      for (int i = 0; i < n; ++i) {
-        if (candidate[i]) final_query(lane_slots[i]);
-        else pool.done.push_back(lane_slots[i]);
+      if (k_) {
+        const int width = k_->lanes;
+        for (uint32_t base = 0; base < n; base += uint32_t(width)) {
+          const int lanes = int(std::min<uint32_t>(uint32_t(width), n - base));
+          PathState<float>* st[kMaxShadeLanes];
+          for (int i = 0; i < width; ++i) st[i] = &pool_.state[slots[base + uint32_t(i < lanes ? i : 0)]];
+          bool candidate[kMaxShadeLanes];
+          k_->final_vertex_candidates(job_.scene, st, candidate);
+          for (int i = 0; i < lanes; ++i) {
+            if (candidate[i]) query(slots[base + uint32_t(i)]);
+            else finish(slots[base + uint32_t(i)]);
+          }
+        }
+        return;
       }
     }
-    n = 0;
-  };
-  size_t keep = 0;
-  for (uint32_t slot : pool.live) {
-    const PathState<T>& st = pool.state[slot];
-    if (!path_at_final_vertex(job.scene, job.config, st)) {
-      pool.live[keep++] = slot;
-      continue;
-    }
-    if constexpr (std::is_same_v<T, float>) {
-      if (k) {
-        lanes[n] = &pool.state[slot];
-        lane_slots[n] = slot;
-        if (++n == k->lanes) flush();
-        continue;
-      }
-    }
-    final_query(slot);
+    for (uint32_t i = 0; i < n; ++i) query(slots[i]);
   }
-  if (n > 0) flush();
-  pool.live.resize(keep);
-}
 
-// The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
-// are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W);
-// false (nothing done) without kernels or for double records, which the caller
-// converts lane by lane (set_lane).
-template <int W, class Record>
-bool rays_to_packet(const BatchKernels* k, const std::vector<Record>& records, const uint32_t* slots, int n,
-                    RTCRayNt<W>& r) {
-  if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
-    if (!k) return false;
-    const void* rows[W];
-    for (int i = 0; i < W; ++i) rows[i] = &records[slots[i < n ? i : 0]];
-    float* const out[6] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z};
-    k->rays_to_packet(rows, out);
-    return true;
-  }
-  return false;
-}
-
-// With kernels `k` (float, a vector ISA) each packet's rays come by one transpose
-// (rays_to_packet) instead of lane by lane.
-// With `tiny` (and k) the tiny-scene test answers first, Embree only where it is unsure.
-template <int W, class T>
-void stage_intersect(const TraceJob& job, const BatchKernels* k, const TinyScene* tiny, PoolSlice<T>& pool,
-                     RTCIntersectContext& ctx, Local& local) {
-  alignas(64) RTCRayHitNt<W> packet;
-  alignas(64) int valid[W];
-  init_packet_constants(packet.ray);
-  for (size_t base = 0; base < pool.live.size(); base += W) {
-    const int n = int(std::min<size_t>(W, pool.live.size() - base));
-    const uint32_t* slots = &pool.live[base];
-    const bool filled = rays_to_packet<W>(k, pool.state, slots, n, packet.ray);
-    for (int i = 0; i < W; ++i) {
-      valid[i] = i < n ? -1 : 0;
-      if (i < n) {
-        const PathState<T>& st = pool.state[slots[i]];
-        count_ray(local.rays, st.depth, &RayCounts::bounce);
-        if (!filled) set_lane(packet.ray, i, st.ray, kInfinity);
-      }
-      packet.ray.tfar[i] = kInfinity;
-      packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-    }
-    if (tiny && filled) {
+  // One pass over `live`: closest hits a packet at a time, each hit shaded (a batch at a
+  // time with kernels), each path routed at once; `live` keeps the paths that go on, in
+  // place (a path is written back only after it was read).
+  PB_CPU_FLATTEN void trace_live() {
+    const uint32_t n_live = pool_.n_live;
+    keep_ = 0;
+    closest_ += n_live;
+    for (uint32_t base = 0; base < n_live; base += W) {
+      const int n = int(std::min<uint32_t>(W, n_live - base));
+      // Read in place: routing writes `live` only below the paths routed so far, all of
+      // which were read before (lane i's slot is read before any path after it is routed).
+      const uint32_t* slots = &pool_.live[base];
       uint32_t prim[W];
-      tiny_closest<W>(*k, *tiny, job.embree, ctx, packet, n, prim);
-      for (int i = 0; i < n; ++i) pool.prim[slots[i]] = prim[i];
-      continue;
-    }
-    intersect_packet(valid, job.embree.handle(), &ctx, packet);
-    for (int i = 0; i < n; ++i) pool.prim[slots[i]] = packet_triangle(job.embree, packet, i);
-  }
-}
-
-// Diffuse-only scenes in float (the paper's case) with a vector ISA: k.lanes paths at a
-// time (shade_x8.h), bit-identical to the scalar path step below.
-PB_CPU_FLATTEN void stage_shade_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table,
-                                        PoolSlice<float>& pool, Local& local) {
-  pool.next_live.clear();
-  ShadeBatch batch;
-  auto flush = [&] {
-    for (int i = batch.lanes; i < k.lanes; ++i) {  // idle lanes repeat lane 0
-      batch.st[i] = batch.st[0];
-      batch.shadow[i] = batch.shadow[0];
-      batch.prim[i] = batch.prim[0];
-    }
-    k.shade_diffuse(job.scene, job.config, table, batch);
-    for (int i = 0; i < batch.lanes; ++i) {
-      const uint32_t slot = uint32_t(batch.st[i] - pool.state.data());
-      if (batch.wants_shadow[i]) {
-        pool.shadowed.push_back(slot);
-        ++local.rays.shadow;
+      closest(slots, n, prim);
+      if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
+        if (table_) {
+          batch_hits(slots, prim, n);
+          continue;
+        }
       }
-      (batch.cont[i] ? pool.next_live : pool.done).push_back(slot);
+      for (int i = 0; i < n; ++i) {
+        if (prim[i] == RTC_INVALID_GEOMETRY_ID) finish(slots[i]);
+        else shade(slots[i], prim[i]);
+      }
     }
-    batch.lanes = 0;
-  };
-  batch.lanes = 0;
-  for (uint32_t slot : pool.live) {
-    if (pool.prim[slot] == RTC_INVALID_GEOMETRY_ID) {
-      pool.done.push_back(slot);
-      continue;
-    }
-    batch.st[batch.lanes] = &pool.state[slot];
-    batch.shadow[batch.lanes] = &pool.shadow[slot];
-    batch.prim[batch.lanes] = pool.prim[slot];
-    if (++batch.lanes == k.lanes) flush();
+    if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly)
+      if (batch_.lanes > 0) shade_batch();
+    pool_.n_live = keep_;
   }
-  if (batch.lanes > 0) flush();
-  std::swap(pool.live, pool.next_live);
-}
 
-// `table`: non-null where the batched shading runs (batched_shading_table), with `k`.
-template <class T, uint32_t Kinds>
-PB_CPU_FLATTEN void stage_shade(const TraceJob& job, const BatchKernels* k, const ShadeTable* table, PoolSlice<T>& pool,
-                                Local& local) {
-  if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
-    if (table) {
-      stage_shade_batched(job, *k, *table, pool, local);
+  // The hit triangle (or RTC_INVALID_GEOMETRY_ID) of each of the n <= W paths' rays: one
+  // packet; with `tiny` (and k) the tiny-scene test answers first, Embree only where it
+  // is unsure.
+  void closest(const uint32_t* slots, int n, uint32_t* prim) {
+    RTCRayHitNt<W>& p = hit_packet_;
+    const bool filled = rays_to_packet<W>(k_, pool_.state.data(), slots, n, p.ray);
+    if (!filled)
+      for (int i = 0; i < n; ++i) set_lane(p.ray, i, pool_.state[slots[i]].ray, kInfinity);
+    // tfar and geomID hold their start values here (reset_packet after each Embree call).
+    if (tiny_ && filled) {
+      if (tiny_closest<W>(*k_, *tiny_, job_.embree, ctx_, p, n, prim) > 0) reset_packet(p);
       return;
     }
+    alignas(64) int valid[W];
+    for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+    intersect_packet(valid, job_.embree.handle(), &ctx_, p);
+    for (int i = 0; i < n; ++i) prim[i] = packet_triangle(job_.embree, p, i);
+    reset_packet(p);
   }
-  pool.next_live.clear();
-  for (uint32_t slot : pool.live) {
-    PathState<T>& st = pool.state[slot];
-    if (pool.prim[slot] == RTC_INVALID_GEOMETRY_ID) {
-      pool.done.push_back(slot);
-      continue;
+
+  // A packet's hits into the shading batch (as shade() does, with the pool's pointers and
+  // the batch's count in registers: ~20 instructions a hit instead of ~32).
+  void batch_hits(const uint32_t* slots, const uint32_t* prim, int n) {
+    if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
+      PathState<float>* const state = pool_.state.data();
+      ShadowQuery<float>* const shadow = pool_.shadow.data();
+      int b = batch_.lanes;
+      for (int i = 0; i < n; ++i) {
+        const uint32_t slot = slots[i];
+        if (prim[i] == RTC_INVALID_GEOMETRY_ID) {
+          finish(slot);
+          continue;
+        }
+        batch_.st[b] = state + slot;
+        batch_.shadow[b] = shadow + slot;
+        batch_.prim[b] = prim[i];
+        batch_slot_[b] = slot;
+        if (++b == W) {
+          batch_.lanes = W;
+          shade_batch();
+          b = 0;
+        }
+      }
+      batch_.lanes = b;
     }
+  }
+
+  // The path step at one hit (path_hit); batch_hits where the batched step runs.
+  void shade(uint32_t slot, uint32_t prim) {
+    PathState<T>& st = pool_.state[slot];
     bool wants_shadow;
     const PathEvent ev =
-        path_hit<Kinds>(job.scene, job.config, st, surface_hit(job.scene, pool.prim[slot], st.ray), pool.shadow[slot], wants_shadow);
-    if (wants_shadow) {
-      pool.shadowed.push_back(slot);
-      ++local.rays.shadow;
-    }
-    if (ev == PathEvent::Continue) pool.next_live.push_back(slot);
-    else pool.done.push_back(slot);
+        path_hit<Kinds>(job_.scene, job_.config, st, surface_hit(job_.scene, prim, st.ray), pool_.shadow[slot], wants_shadow);
+    route(slot, wants_shadow, ev == PathEvent::Continue);
   }
-  std::swap(pool.live, pool.next_live);
-}
 
-template <int W, class T>
-void stage_shadow(const TraceJob& job, const BatchKernels* k, const TinyScene* tiny, PoolSlice<T>& pool,
-                  RTCIntersectContext& ctx) {
-  alignas(64) RTCRayNt<W> packet;
-  alignas(64) int valid[W];
-  init_packet_constants(packet);
-  for (size_t base = 0; base < pool.shadowed.size(); base += W) {
-    const int n = int(std::min<size_t>(W, pool.shadowed.size() - base));
-    const uint32_t* slots = &pool.shadowed[base];
-    const bool filled = rays_to_packet<W>(k, pool.shadow, slots, n, packet);
-    for (int i = 0; i < W; ++i) {
-      valid[i] = i < n ? -1 : 0;
-      if (i < n && !filled) set_lane(packet, i, pool.shadow[slots[i]].ray, 1.0f);
-      packet.tfar[i] = 1.0f;
+  // The batch's paths through k.shade_diffuse (shade_x8.h), bit-identical to path_hit.
+  void shade_batch() {
+    if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
+      const int lanes = batch_.lanes;
+      for (int i = lanes; i < W; ++i) {  // idle lanes repeat lane 0
+        batch_.st[i] = batch_.st[0];
+        batch_.shadow[i] = batch_.shadow[0];
+        batch_.prim[i] = batch_.prim[0];
+      }
+      k_->shade_diffuse(job_.scene, job_.config, *table_, batch_);
+      batch_.lanes = 0;
+      for (int i = 0; i < lanes; ++i) route(batch_slot_[i], batch_.wants_shadow[i], batch_.cont[i]);
     }
-    if (tiny && filled) {
-      bool blocked[W];
-      tiny_occluded<W>(*k, *tiny, job.embree, ctx, packet, n, blocked);
-      for (int i = 0; i < n; ++i)
-        if (!blocked[i]) shadow_unoccluded(pool.state[slots[i]], pool.shadow[slots[i]]);
-      continue;
+  }
+
+  // Where a shaded path goes: its shadow ray to the pending packet; the path back to
+  // `live`, to `final` (its next vertex is its last), or, ended, to the film (after its
+  // shadow ray, if any).
+  void route(uint32_t slot, bool wants_shadow, bool cont) {
+    if (wants_shadow) {
+      ++local_.rays.shadow;
+      queue_shadow(slot, !cont);
     }
-    occluded_packet(valid, job.embree.handle(), &ctx, packet);
+    if (cont) {
+      if (pool_.state[slot].depth >= final_depth_) pool_.final[pool_.n_final++] = slot;
+      else pool_.live[keep_++] = slot;
+    } else if (!wants_shadow) {
+      finish(slot);
+    }
+  }
+
+  // A shadow ray waits for a full packet; `ends`: its path is done once it is answered.
+  void queue_shadow(uint32_t slot, bool ends) {
+    shadow_slot_[n_shadow_] = slot;
+    shadow_ends_[n_shadow_] = ends;
+    if (++n_shadow_ == W) trace_shadows();
+  }
+
+  // The pending shadow rays as one packet (the tiny test first where it applies).
+  void trace_shadows() {
+    const int n = n_shadow_;
+    n_shadow_ = 0;
+    const uint32_t* slots = shadow_slot_;
+    RTCRayNt<W>& p = shadow_packet_;
+    const bool filled = rays_to_packet<W>(k_, pool_.shadow.data(), slots, n, p);
+    if (!filled)
+      for (int i = 0; i < n; ++i) set_lane(p, i, pool_.shadow[slots[i]].ray, 1.0f);
+    bool blocked[W];  // tfar holds 1 here (reset_packet after each Embree call)
+    if (tiny_ && filled) {
+      if (tiny_occluded<W>(*k_, *tiny_, job_.embree, ctx_, p, n, blocked) > 0) reset_packet(p);
+    } else {
+      alignas(64) int valid[W];
+      for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+      occluded_packet(valid, job_.embree.handle(), &ctx_, p);
+      for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
+      reset_packet(p);
+    }
     for (int i = 0; i < n; ++i) {
       const uint32_t slot = slots[i];
-      if (packet.tfar[i] >= 0.0f) shadow_unoccluded(pool.state[slot], pool.shadow[slot]);
+      if (!blocked[i]) shadow_unoccluded(pool_.state[slot], pool_.shadow[slot]);
+      if (shadow_ends_[i]) finish(slot);
     }
   }
-  pool.shadowed.clear();
-}
 
-template <class T> void stage_accumulate(const TraceJob& job, PoolSlice<T>& pool, Local& local) {
-  for (uint32_t slot : pool.done) {
-    const PathState<T>& st = pool.state[slot];
-    if (!job.film.add_atomic(st.pixel, Vec3f(st.L))) ++local.discarded;
-    pool.free.push_back(slot);
+  // A path is done: its radiance to the film, its slot free.
+  void finish(uint32_t slot) {
+    if (!job_.film.add_atomic(pool_.state[slot].pixel, Vec3f(pool_.state[slot].L))) ++local_.discarded;
+    pool_.free[pool_.n_free++] = slot;
+    ++finished_;
   }
-  local.paths += pool.done.size();
-  job.progress.advance(pool.done.size());
-  pool.done.clear();
-}
 
-// The stages above, in scalar type T, compiled for the material kinds `Kinds`
-// (features.h), with packets of W rays; `k` (width W) where the batched path step runs.
+  const TraceJob& job_;
+  const BatchKernels* k_;
+  const ShadeTable* table_;
+  const TinyScene* tiny_;
+  SampleSource& src_;
+  PoolSlice<T> pool_;
+  Local& local_;
+  RTCIntersectContext ctx_;
+  uint32_t final_depth_ = std::numeric_limits<uint32_t>::max();  // never, without the final query
+  alignas(64) RTCRayHitNt<W> hit_packet_;
+  alignas(64) RTCRayNt<W> shadow_packet_;
+  ShadeBatch batch_{};
+  uint32_t batch_slot_[kMaxShadeLanes];
+  uint32_t shadow_slot_[W];
+  bool shadow_ends_[W];
+  int n_shadow_ = 0;
+  uint32_t keep_ = 0;                            // paths kept in `live` by the pass so far
+  uint64_t finished_ = 0;                        // paths done this round
+  uint64_t camera_ = 0, closest_ = 0;            // closest-hit queries: of new paths, in all
+};
+
+// The slices over the pool, one per thread; `k` (width W) where the batched path step runs.
 template <class T, uint32_t Kinds, int W>
 TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
                       std::unique_ptr<ShadeTable> table) {
@@ -317,19 +380,8 @@ TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const Batch
   const std::unique_ptr<TinyScene> tiny = tiny_scene_for(job.embree, job.scene, k);
   tbb::combinable<Local> locals;
   tbb::parallel_for(0, slices, [&](int) {
-    Local& local = locals.local();
-    PoolSlice<T> pool(per_slice);
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    for (;;) {
-      stage_generate(job, k, source, pool);
-      if (pool.live.empty()) break;
-      stage_final_vertex<T, Kinds>(job, k, pool, local);
-      stage_intersect<W>(job, k, tiny.get(), pool, ctx, local);
-      stage_shade<T, Kinds>(job, k, table.get(), pool, local);
-      stage_shadow<W>(job, k, tiny.get(), pool, ctx);
-      stage_accumulate(job, pool, local);
-    }
+    auto slice = std::make_unique<Slice<T, Kinds, W>>(job, k, table.get(), tiny.get(), source, per_slice, locals.local());
+    slice->run();
   }, tbb::static_partitioner());
   TraceTotals t;
   locals.combine_each([&](const Local& l) {

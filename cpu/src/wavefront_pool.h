@@ -27,6 +27,7 @@ class SampleSource {
   }
   uint32_t pixel_of(uint64_t g) const { return uint32_t(g % pixels_); }
   uint32_t sample_of(uint64_t g) const { return first_ + uint32_t(g / pixels_); }
+  uint32_t pixels() const { return pixels_; }
 
  private:
   std::atomic<uint64_t> next_{0};
@@ -35,22 +36,22 @@ class SampleSource {
   uint32_t first_;  // samples [first_, first_ + total_ / pixels_) of each pixel
 };
 
+// One thread's share of the paths in flight. Every slot is in exactly one place at a
+// time: `free`, `live` (its next ray is a closest-hit query), `final` (at its last
+// vertex: the emitter query), or a pending shadow packet of the stages (at most one
+// packet's worth, outside the pool). The lists are fixed arrays with counts, not
+// growing vectors: the stages append with one store each, and `live` is compacted in
+// place by the pass that reads it (render_wavefront.cpp).
 template <class T> struct PoolSlice {
-  explicit PoolSlice(size_t n) : state(n), shadow(n), prim(n) {
-    free.reserve(n);
-    live.reserve(n);
-    next_live.reserve(n);
-    shadowed.reserve(n);
-    done.reserve(n);
-    for (size_t i = n; i-- > 0;) free.push_back(uint32_t(i));
+  explicit PoolSlice(size_t n) : state(n), shadow(n), free(n), live(n), final(n), n_free(uint32_t(n)) {
+    for (size_t i = 0; i < n; ++i) free[i] = uint32_t(n - 1 - i);
   }
   std::vector<PathState<T>> state;
   std::vector<ShadowQuery<T>> shadow;
-  std::vector<uint32_t> prim;  // hit triangle, or RTC_INVALID_GEOMETRY_ID
-  std::vector<uint32_t> free, live, next_live, shadowed, done;
+  std::vector<uint32_t> free, live, final;
+  uint32_t n_free, n_live = 0, n_final = 0;
 
-  static constexpr size_t bytes_per_path =
-      sizeof(PathState<T>) + sizeof(ShadowQuery<T>) + sizeof(uint32_t) * 6;
+  static constexpr size_t bytes_per_path = sizeof(PathState<T>) + sizeof(ShadowQuery<T>) + sizeof(uint32_t) * 3;
 };
 
 struct Local {

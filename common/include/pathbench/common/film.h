@@ -83,6 +83,8 @@ class Film {
 inline bool Film::add(uint32_t pixel, Vec3f L) {
   if (!sample_acceptable(L, limit_)) return false;
   int64_t* s = &sum_[size_t(pixel) * 3];
+  // Unrolled (g++ keeps these three-step loops as loops: ~12 more instructions a sample).
+#pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) s[c] += quantize_radiance(L[c], scale_);
   ++count_[pixel];
   if (!sum_sq_.empty())
@@ -93,6 +95,7 @@ inline bool Film::add(uint32_t pixel, Vec3f L) {
 inline bool Film::add_atomic(uint32_t pixel, Vec3f L) {
   if (!sample_acceptable(L, limit_)) return false;
   int64_t* s = &sum_[size_t(pixel) * 3];
+#pragma GCC unroll 3
   for (int c = 0; c < 3; ++c)
     std::atomic_ref<int64_t>(s[c]).fetch_add(quantize_radiance(L[c], scale_), std::memory_order_relaxed);
   std::atomic_ref<uint32_t>(count_[pixel]).fetch_add(1, std::memory_order_relaxed);
