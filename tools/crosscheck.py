@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -101,9 +102,13 @@ def main(argv=None) -> int:
             return 2
     try:
         ref, var_ref, spp = render_mitsuba(a.xml, a.variant, a.spp, a.passes)
-    except ImportError as e:
+    except ModuleNotFoundError as e:
         print(f"crosscheck.py: error: Mitsuba 3 is not installed ({e}); scripts/install-deps.sh installs it",
               file=sys.stderr)
+        return 2
+    except ImportError as e:  # installed, but it failed to load (seen: another Embree first on LD_LIBRARY_PATH)
+        print(f"crosscheck.py: error: Mitsuba 3 is installed but failed to load ({e}); a library it needs may be "
+              f"missing or shadowed (LD_LIBRARY_PATH={os.environ.get('LD_LIBRARY_PATH', '')!r})", file=sys.stderr)
         return 2
     except RuntimeError as e:  # Mitsuba's parser: the message names the file and line
         print(f"crosscheck.py: error: Mitsuba cannot load {a.xml}: {e}", file=sys.stderr)

@@ -1,9 +1,17 @@
 """tools/crosscheck.py's judgement (no Mitsuba needed): the suite's per-pixel z-test
 with a Sidak-corrected level, exact agreement where neither side has variance, and the
 per-channel mean rule."""
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 
 import crosscheck
+import mitsuba_scene as ms
+
+TOOLS = Path(__file__).resolve().parents[2] / "tools"
 
 
 def noisy(mean, var, seed):
@@ -37,3 +45,25 @@ def test_values_without_variance_must_agree_exactly():
     off = ours * 1.01
     summary, z = crosscheck.compare(off, zero, ours, zero, 0.02)
     assert not summary["pass"] and summary["zero_variance_failed"] == ours.size and np.isinf(z).all()
+
+
+def _run_with_fake_mitsuba(tmp_path, init_text):
+    """crosscheck.py with a stand-in `mitsuba` package first on the path."""
+    fake = tmp_path / "fake" / "mitsuba"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text(init_text)
+    image = np.ones((2, 2, 3), np.float32)
+    ms.write_pfm(tmp_path / "pathbench-cpu.pfm", image)
+    ms.write_pfm(tmp_path / "pathbench-cpu-var.pfm", image * 0)
+    env = dict(os.environ, PYTHONPATH=f"{tmp_path / 'fake'}{os.pathsep}{TOOLS}")
+    return subprocess.run([sys.executable, str(TOOLS / "crosscheck.py"), "--xml", str(tmp_path / "scene.xml"),
+                           "--image", f"cpu={tmp_path / 'pathbench-cpu.pfm'}", "--out-dir", str(tmp_path / "out")],
+                          capture_output=True, text=True, env=env, timeout=60)
+
+
+def test_a_mitsuba_that_fails_to_load_is_not_called_missing(tmp_path):
+    r = _run_with_fake_mitsuba(tmp_path, "raise ImportError('undefined symbol: rtcOccluded4')\n")
+    assert r.returncode == 2, r.stderr
+    assert "Mitsuba 3 is installed but failed to load (undefined symbol: rtcOccluded4)" in r.stderr
+    assert "not installed" not in r.stderr
+    assert not (tmp_path / "out").exists()
