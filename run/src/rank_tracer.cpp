@@ -63,6 +63,7 @@ void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
       chunk.extra["bvh_layout"] = cpu_->gpu_bvh->layout();
     }
     cpu_->gpu_bvh->render(s, film, chunk);  // Film::add accumulates into the rank's film
+    chunk.tracer_host_bytes = film.bytes() + cpu_->gpu_bvh->bvh_bytes();
   } else if (s.device == Device::Cpu) {
     cpu::render(scene_, *cpu_->scene, s, film, chunk);  // Film::add accumulates into the rank's film
   } else {

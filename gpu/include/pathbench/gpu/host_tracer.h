@@ -6,6 +6,7 @@
 // CPU working beside GPUs on one frame (the hybrid CPU+GPU render, run/'s RankTracer):
 // then the frame's image is one GPU's whichever device took which samples. In every
 // build, with or without CUDA (pathbench::gpu_bvh).
+#include <cstdint>
 #include <string>
 
 #include "pathbench/common/film.h"
@@ -27,6 +28,7 @@ class HostGpuTracer {
   // discarded samples and seconds to `report`.
   void render(const RenderSettings& settings, Film& film, RunReport& report) const;
   std::string layout() const { return to_string(bvh_.layout); }
+  uint64_t bvh_bytes() const { return bvh_.bytes(); }
 
  private:
   const Scene& scene_;
