@@ -40,15 +40,17 @@ int follow_rank0() {
     if (name == kStop) return 0;
     try {
       std::shared_ptr<const Scene> scene;
+      const RenderCase* frame = nullptr;
       run::on_every_rank([&] {
         const auto it = render_cases().find(name);
         if (it == render_cases().end())
           throw std::runtime_error(fmt::format("no render benchmark '{}' here (the ranks' command lines differ?)", name));
-        scene = cached_scene(it->second.scene);
+        frame = &it->second;
+        scene = cached_scene(frame->scene);
       });
       Film film;
       RunReport report;
-      run::render_ranks(*scene, render_cases()[name].settings, film, report);
+      run::render_ranks(*scene, frame->settings, film, report);
     } catch (const run::PeerFailure&) {
       // Agreed by every rank: rank 0 skips that benchmark and goes on; so does this rank.
     } catch (const std::exception& e) {
