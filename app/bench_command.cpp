@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +16,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/output_file.h"
+#include "pathbench/run/world.h"
 
 namespace pb::app {
 
@@ -49,15 +49,6 @@ void check_complete_json(OutputFile& out) {
                                  display_path(out.path())));
 }
 
-// Under mpirun each rank's `pathbench bench` starts a pathbench-bench that joins the
-// run as that rank (bench/bench_ranks.h); only rank 0's writes results. Read from the
-// launcher's environment: this process itself never starts MPI.
-bool launched_as_other_rank() {
-  for (const char* v : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})
-    if (const char* r = std::getenv(v)) return std::string(r) != "0";
-  return false;
-}
-
 }  // namespace
 
 void add_bench_options(CLI::App& cmd, BenchOptions& o) {
@@ -81,7 +72,9 @@ int run_bench(const BenchOptions& o, const std::vector<std::string>& passthrough
   // unchecked, in place); it is renamed into place only when pathbench-bench
   // succeeded and the file holds complete JSON. So this runs it as a child.
   std::optional<OutputFile> out;
-  if (!o.out.empty() && !launched_as_other_rank()) {
+  // Under mpirun each rank's `pathbench bench` starts a pathbench-bench that joins the
+  // run as that rank (bench/bench_ranks.h); only rank 0's writes results.
+  if (!o.out.empty() && run::launcher_rank() <= 0) {
     if (image_extension(o.out) != ".json")
       throw InputError(fmt::format("--out {}: the benchmark results are JSON; name it .json", display_path(o.out)));
     check_output_path(o.out, "--out");

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <climits>
-#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -21,12 +20,6 @@ namespace {
 World* g_world = nullptr;
 MPI_Comm g_local = MPI_COMM_NULL, g_chunks = MPI_COMM_NULL;
 
-// Started by mpirun (OpenMPI), or by another PMI launcher (srun, MPICH's hydra).
-bool launched_by_mpi() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-    if (std::getenv(v)) return true;
-  return false;
-}
 
 // A sum no film holds (|sum| < 2^62 + 2^62): the checked reduction's "overflowed", sticky.
 constexpr int64_t kOverflowed = INT64_MIN;
@@ -71,7 +64,7 @@ MPI_Comm mpi_detail::chunk_comm() { return g_chunks; }
 World::World() {
   char name[HOST_NAME_MAX + 1] = {};
   if (::gethostname(name, sizeof name - 1) == 0) host_ = name;
-  if (!launched_by_mpi()) return;
+  if (launcher_rank() < 0) return;  // not started by mpirun or another PMI launcher
   int provided = MPI_THREAD_SINGLE;
   // Rank 0's dispenser thread makes MPI calls while the main thread renders (and makes
   // none): SERIALIZED is enough, MULTIPLE is asked for.
@@ -129,9 +122,9 @@ std::string World::announce(const std::string& message) {
     if (done) break;
     if (!root()) ::nanosleep(&step, nullptr);
   }
-  std::string out = root() ? message : std::string(size_t(len), '\0');
   // Announcements are short (a benchmark's name); MPI counts are int.
   if (len > uint64_t(INT_MAX)) throw std::length_error("World::announce: message too long");
+  std::string out = root() ? message : std::string(size_t(len), '\0');
   MPI_Bcast(out.data(), int(len), MPI_CHAR, 0, MPI_COMM_WORLD);
   return out;
 }

@@ -2,11 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "pathbench/run/world.h"
 
 namespace pb::run {
+
+int launcher_rank() {
+  for (const char* v : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})  // OpenMPI, PMIx (srun), PMI (hydra)
+    if (const char* r = std::getenv(v)) return std::max(0, std::atoi(r));
+  return -1;
+}
 
 SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp) {
   if (ranks == 0 || rank >= ranks) throw std::invalid_argument("share_of: rank out of range");

@@ -4,7 +4,6 @@
 
 #include <climits>
 #include <cstdio>
-#include <cstdlib>
 
 #include "pathbench/run/world.h"
 
@@ -14,7 +13,7 @@ World::World() {
   char name[HOST_NAME_MAX + 1] = {};
   if (::gethostname(name, sizeof name - 1) == 0) host_ = name;
   // Started by mpirun all the same: say so once, rather than render N whole frames silently.
-  if (std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE"))
+  if (launcher_rank() >= 0)
     std::fputs("pathbench: warning: started by an MPI launcher, but this build has no MPI (configure with "
                "-DPATHBENCH_MPI=ON and libopenmpi-dev): every process renders the whole frame on its own\n",
                stderr);

@@ -82,6 +82,11 @@ class World {
   bool threads_ok_ = false;
 };
 
+// This process's rank as an MPI launcher (mpirun, srun, MPICH's hydra) set it in the
+// environment, or -1 when no launcher started it. Read without starting MPI: World uses
+// it to decide whether to, and `pathbench bench` (app/) for the child that joins the run.
+int launcher_rank();
+
 // Dynamic balancing: ranks take chunks of samples ([first, first + count) of every
 // pixel) from one counter held by rank 0, which answers the other ranks from a thread of
 // its own while it renders. A chunk's size follows the asking rank's measured rate (its
