@@ -4,7 +4,8 @@
 # CPU+GPU hybrid give the one-GPU image byte for byte, that pathbench-bench's GPU render
 # benchmarks over 2 ranks give one process's film hashes, and run tools/mpi_scaling.py.
 # Everything lands under $OUT (default ./device-out). Phases: build gpu check bench scaling
-# (gpu: ctest -L gpu in the same build).
+# hybrid (gpu: ctest -L gpu in the same build; hybrid: one GPU alone against the hybrid,
+# interleaved rounds, REPS=5 by default).
 #   source .gpu-deps/unpack.sh is done here (pack-deps.sh --mpi); ../shared/gpu-host/README.md.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -61,6 +62,25 @@ if has check; then
     log "$tag seconds [frame share efficiency reduce]: gpu1 $(secs "$OUT/gpu1-$tag.json") | gpu2 $(secs "$OUT/gpu2-$tag.json") | hybrid $(secs "$OUT/hy-$tag.json")"
   done
   rm -f "$OUT"/*.pfm
+fi
+if has hybrid; then
+  # Interleaved rounds: one GPU process, then the hybrid (1 GPU + 1 CPU rank), same frame.
+  # Both timed from the frame's start to the film on the host: the GPU's `seconds` (host
+  # clock around its frame) plus its film download, against the hybrid's frame_seconds
+  # (common start to the film reduced on rank 0).
+  mkdir -p "$OUT/hybrid"
+  for frame in "256 256 800" "2048 2048 1024"; do
+    set -- $frame
+    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2"
+    for i in $(seq 1 ${REPS:-5}); do
+      $PB $f --device gpu --out "$OUT/g.pfm" --report "$OUT/hybrid/gpu-$1-$i.json"
+      mpi -np 1 $PB $f --device gpu --out "$OUT/h.pfm" --report "$OUT/hybrid/hy-$1-$i.json" : \
+          -np 1 $PB $f --device cpu --out "$OUT/h.pfm" --report "$OUT/hybrid/hy-$1-$i.json"
+      same "$OUT/g.pfm" "$OUT/h.pfm" "$1x$2x$3 round $i: hybrid vs one GPU"
+    done
+  done
+  rm -f "$OUT"/*.pfm
+  python3 tools/hybrid_timing.py "$OUT/hybrid" | tee "$OUT/hybrid.md" | tee -a "$OUT/summary.txt"
 fi
 if has bench; then
   # Every GPU render benchmark of the quick preset: 1 process, then 2 ranks (one frame

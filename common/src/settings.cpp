@@ -108,6 +108,9 @@ void RenderSettings::validate() const {
   if (first_sample >= spp || uint64_t(first_sample) + traced_spp() > spp)
     throw std::invalid_argument(fmt::format("sample range [{}, +{}) outside the frame's {} spp", first_sample,
                                             sample_count, spp));
+  if (first_row >= height || uint64_t(first_row) + traced_rows() > height)
+    throw std::invalid_argument(fmt::format("row range [{}, +{}) outside the frame's {} rows", first_row, row_count,
+                                            height));
 }
 
 }  // namespace pb

@@ -36,8 +36,10 @@ void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings&
 
   Progress progress(fmt::format("render {} cpu/{}", scene.name, to_string(settings.strategy)),
                     settings.traced_samples(), settings.progress);
-  // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share).
-  TraceJob job{embree, scene.view(), settings.path_config(), settings.traced_spp(), film, progress, isa};
+  // Samples [first_sample, first_sample + traced_spp()) of each pixel of rows [first_row,
+  // first_row + traced_rows()) (an MPI rank's share or chunk).
+  TraceJob job{embree, scene.view(), settings.path_config(), settings.traced_spp(), settings.traced_rows(), film,
+               progress, isa};
 
   const auto t0 = std::chrono::steady_clock::now();
   // A pool larger than the frame's samples would only hold empty slots (--paths-in-flight 1e8 for 64

@@ -205,9 +205,9 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
   const std::unique_ptr<ShadeTable> table = batched_shading_table<T, Kinds>(job.scene, job.isa);
   const BatchKernels* k = table ? batch_kernels(job.isa) : nullptr;
   const std::unique_ptr<TinyScene> tiny = tiny_scene_for(job.embree, job.scene, k);
-  const uint32_t w = job.config.width, h = job.config.height;
+  const uint32_t w = job.config.width, y0 = job.config.first_pixel / w;
   tbb::combinable<Local> locals;
-  tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, h, kTile, 0, w, kTile), [&](const auto& tile) {
+  tbb::parallel_for(tbb::blocked_range2d<uint32_t>(y0, y0 + job.rows, kTile, 0, w, kTile), [&](const auto& tile) {
     Local& local = locals.local();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

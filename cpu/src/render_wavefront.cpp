@@ -101,10 +101,10 @@ template <class T, uint32_t Kinds, int W> class Slice {
     uint32_t& count = at_final ? pool_.n_final : pool_.n_live;
     if (!at_final) camera_ += n;
     uint32_t pixel = src_.pixel_of(start), sample = src_.sample_of(start);
-    const uint32_t pixels = src_.pixels();
+    const uint32_t first_pixel = src_.first_pixel(), end_pixel = src_.end_pixel();
     auto next = [&] {  // (pixel, sample) of the next global index, without a division
-      if (++pixel == pixels) {
-        pixel = 0;
+      if (++pixel == end_pixel) {
+        pixel = first_pixel;
         ++sample;
       }
     };
@@ -366,8 +366,8 @@ template <class T, uint32_t Kinds, int W> class Slice {
 template <class T, uint32_t Kinds, int W>
 TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
                       std::unique_ptr<ShadeTable> table) {
-  const uint32_t pixels = job.config.width * job.config.height;
-  SampleSource source(uint64_t(pixels) * job.spp, pixels, job.config.first_sample);
+  const uint32_t pixels = job.config.width * job.rows;
+  SampleSource source(uint64_t(pixels) * job.spp, job.config.first_pixel, pixels, job.config.first_sample);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
   // A pool that cannot fit is a setting to lower, not a std::bad_alloc (exit 2, not 1).

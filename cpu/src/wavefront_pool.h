@@ -14,25 +14,28 @@ namespace pb::cpu {
 namespace {
 
 // Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
-// are neighbours on the image (coherent camera rays).
+// are neighbours on the image (coherent camera rays): `pixels` pixels from `first_pixel`
+// on (whole rows: an MPI rank's chunk may be a band of the frame), each with samples
+// [first_sample, first_sample + total / pixels).
 class SampleSource {
  public:
-  SampleSource(uint64_t total, uint32_t pixels, uint32_t first_sample)
-      : total_(total), pixels_(pixels), first_(first_sample) {}
+  SampleSource(uint64_t total, uint32_t first_pixel, uint32_t pixels, uint32_t first_sample)
+      : total_(total), first_pixel_(first_pixel), pixels_(pixels), first_(first_sample) {}
   // Claims up to n samples; returns the first global index and sets n to the count.
   uint64_t claim(uint64_t& n) {
     uint64_t start = next_.fetch_add(n, std::memory_order_relaxed);
     n = start >= total_ ? 0 : std::min(n, total_ - start);
     return start;
   }
-  uint32_t pixel_of(uint64_t g) const { return uint32_t(g % pixels_); }
+  uint32_t pixel_of(uint64_t g) const { return first_pixel_ + uint32_t(g % pixels_); }
   uint32_t sample_of(uint64_t g) const { return first_ + uint32_t(g / pixels_); }
-  uint32_t pixels() const { return pixels_; }
+  uint32_t first_pixel() const { return first_pixel_; }
+  uint32_t end_pixel() const { return first_pixel_ + pixels_; }
 
  private:
   std::atomic<uint64_t> next_{0};
   uint64_t total_;
-  uint32_t pixels_;
+  uint32_t first_pixel_, pixels_;
   uint32_t first_;  // samples [first_, first_ + total_ / pixels_) of each pixel
 };
 

@@ -18,7 +18,8 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   const SceneView view = scene_.view();
   const BvhView bvh = bvh_.view();
   const PathConfig c = settings.path_config();
-  const uint32_t width = settings.width, height = settings.height, spp = settings.traced_spp();
+  const uint32_t width = settings.width, spp = settings.traced_spp();
+  const uint32_t y0 = settings.first_row, y1 = y0 + settings.traced_rows();  // a rank's band, or the frame
   std::atomic<uint64_t> bounce{0}, shadow{0}, discarded{0};
   // The GPU's choice of kernel (pixel.cu's run_pixel): double precision and the
   // Moeller-Trumbore test switch on the layout at run time, as there; the same code.
@@ -26,7 +27,7 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
     constexpr uint32_t K = decltype(kinds)::value;
     using T = typename decltype(real)::type;
     constexpr bool W = decltype(watertight)::value;
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, height), [&](const tbb::blocked_range<uint32_t>& rows) {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(y0, y1), [&](const tbb::blocked_range<uint32_t>& rows) {
       uint32_t n_bounce = 0, n_shadow = 0, n_discarded = 0;
       for (uint32_t y = rows.begin(); y < rows.end(); ++y)
         for (uint32_t x = 0; x < width; ++x) {
@@ -50,7 +51,7 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
       else trace_rows(kinds, std::type_identity<float>{}, std::true_type{});
     });
   });
-  const uint64_t paths = uint64_t(width) * height * spp;
+  const uint64_t paths = settings.traced_samples();
   report.rays.camera += paths;
   report.rays.bounce += bounce;
   report.rays.shadow += shadow;

@@ -49,7 +49,7 @@ __global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathCon
   for (uint64_t base = warp * 32; base < total; base += warps * 32) {
     const uint64_t g = base + lane;
     const bool valid = g < total;
-    const uint32_t pixel = valid ? uint32_t(g / spp) : 0xFFFFFFFFu;
+    const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / spp) : 0xFFFFFFFFu;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
       L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);

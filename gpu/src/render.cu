@@ -31,28 +31,57 @@
 
 namespace pb::gpu {
 
+struct DeviceFilm::Impl {
+  FilmBuffers fb;
+  bool used = false;
+  uint32_t width = 0, height = 0;
+  bool variance = false;
+};
+
+DeviceFilm::DeviceFilm() : impl_(std::make_unique<Impl>()) {}
+DeviceFilm::~DeviceFilm() = default;
+bool DeviceFilm::used() const { return impl_->used; }
+
 namespace {
+// Film back to the host: the device's unsigned sums are Film's int64 sums mod 2^64.
+double download_film(const FilmBuffers& fb, Film& film) {
+  static_assert(sizeof(unsigned long long) == sizeof(int64_t));
+  const auto t0 = std::chrono::steady_clock::now();
+  fb.sum.download(reinterpret_cast<unsigned long long*>(film.raw_sums().data()), fb.sum.size());
+  fb.count.download(film.counts().data(), fb.count.size());
+  if (film.has_variance()) fb.sum_sq.download(film.raw_sum_sq().data(), fb.sum_sq.size());
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
-                 RunReport& report, bool profile);
+                 RunReport& report, bool profile, DeviceFilm* keep);
 }  // namespace
+
+double DeviceFilm::download(Film& film) const {
+  const Impl& d = *impl_;
+  if (!d.used) throw std::logic_error("DeviceFilm::download: nothing was rendered into it");
+  if (film.width() != d.width || film.height() != d.height || film.has_variance() != d.variance)
+    throw std::logic_error("DeviceFilm::download: the film's size or variance differs from the device film's");
+  return download_film(d.fb, film);
+}
 
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile) {
   // Start the context before measuring memory: its own use is not the tracer's.
   PB_CUDA_CHECK(cudaFree(nullptr));
   DeviceMemory::instance().begin_measurement();
   GpuScene gpu_scene(scene);
-  render_impl(scene, gpu_scene, settings, film, report, profile);
+  render_impl(scene, gpu_scene, settings, film, report, profile, nullptr);
 }
 
 void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film, RunReport& report,
-            bool profile) {
+            bool profile, DeviceFilm* keep) {
   DeviceMemory::instance().begin_measurement();
-  render_impl(scene, gpu_scene, settings, film, report, profile);
+  render_impl(scene, gpu_scene, settings, film, report, profile, keep);
 }
 
 namespace {
 void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
-                 RunReport& report, bool profile) {
+                 RunReport& report, bool profile, DeviceFilm* keep) {
   if (film.width() != settings.width || film.height() != settings.height)
     throw std::logic_error("film size does not match the settings");
   const DeviceInfo info = device_info();  // the device was checked by the run layer (cached)
@@ -69,8 +98,17 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
 
   ScopedStream stream;
   Launcher launch(stream.s, profile);
-  FilmBuffers fb;
-  fb.allocate(film, pixels);
+  // The film on the device: this render's own, or a kept one that earlier renders (an MPI
+  // rank's chunks) added into, allocated and warmed up by the first of them.
+  FilmBuffers own;
+  FilmBuffers& fb = keep ? keep->impl().fb : own;
+  const bool first_use = !keep || !keep->impl().used;
+  if (keep && keep->impl().used) {
+    const DeviceFilm::Impl& k = keep->impl();
+    if (k.width != film.width() || k.height != film.height() || k.variance != film.has_variance())
+      throw std::logic_error("gpu::render: the kept device film's size or variance differs from the film's");
+  }
+  if (first_use) fb.allocate(film, pixels);
 
   if (settings.strategy != Strategy::Pixel && settings.precision != Precision::Float)
     throw InputError(fmt::format("--precision {}: the GPU runs double precision with --strategy pixel only (its "
@@ -113,13 +151,23 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     return pool->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
   };
 
-  // Warm-up (module load, first-touch of every buffer), then the timed frame.
-  fb.clear(stream.s);
-  run_frame(warmup_total);
-  PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
-  mem.sample();
-  launch.clear();
-  fb.clear(stream.s);
+  // Warm-up (module load, first-touch of every buffer), then the timed frame. A kept
+  // film's later renders add to what is there: the first one warmed up.
+  if (first_use) {
+    fb.clear(stream.s);
+    run_frame(warmup_total);
+    PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
+    mem.sample();
+    launch.clear();
+    fb.clear(stream.s);
+  }
+  if (keep) {
+    DeviceFilm::Impl& k = keep->impl();
+    k.used = true;
+    k.width = film.width();
+    k.height = film.height();
+    k.variance = film.has_variance();
+  }
 
   ScopedEvent ev0, ev1;
   PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
@@ -133,11 +181,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   float device_ms = 0;
   PB_CUDA_CHECK(cudaEventElapsedTime(&device_ms, ev0.e, ev1.e));
 
-  // Film back to the host: the device's unsigned sums are Film's int64 sums mod 2^64.
-  static_assert(sizeof(unsigned long long) == sizeof(int64_t));
-  fb.sum.download(reinterpret_cast<unsigned long long*>(film.raw_sums().data()), fb.sum.size());
-  fb.count.download(film.counts().data(), fb.count.size());
-  if (film.has_variance()) fb.sum_sq.download(film.raw_sum_sq().data(), fb.sum_sq.size());
+  const double download_seconds = keep ? 0.0 : download_film(fb, film);
 
   report.seconds = std::chrono::duration<double>(t1 - t0).count();
   report.device_seconds = double(device_ms) / 1e3;
@@ -176,6 +220,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
   if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;
   x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
+  if (!keep) x["film_download_seconds"] = download_seconds;  // after the timed frame, not in it
   if (settings.strategy != Strategy::Pixel) {
     x["state_layout"] = std::string("2 x (o+pdf, d+pixel, beta+depth, L+sample: float4) + hit u32") +
                         (shadows.records ? " + shadow record (o, d: float4; c.z+target: float2; L of a finished path: float4)" : "") +

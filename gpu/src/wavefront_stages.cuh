@@ -58,7 +58,7 @@ __device__ __forceinline__ PathState<float> current_path(const SceneView& s, con
   if (i < fresh.dst) return load_path(cur, i);
   const unsigned long long g = fresh.base + (i - fresh.dst);
   PathState<float> st;
-  path_begin(s, c, uint32_t(g / fresh.spp), c.first_sample + uint32_t(g % fresh.spp), st);
+  path_begin(s, c, c.first_pixel + uint32_t(g / fresh.spp), c.first_sample + uint32_t(g % fresh.spp), st);
   return st;
 }
 

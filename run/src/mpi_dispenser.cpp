@@ -18,20 +18,20 @@ constexpr int kAsk = 1, kGrant = 2, kQuit = 3;
 }
 
 struct SampleDispenser::Impl {
-  Impl(World& w, uint32_t s) : world(w), spp(s) {}
+  Impl(World& w, uint64_t u, uint64_t p) : world(w), units(u), probe(p) {}
   World& world;
-  uint32_t spp;
+  uint64_t units, probe;
   MPI_Comm comm = mpi_detail::chunk_comm();
   // Rank 0's counter, guarded by `m` (its own render and the server thread take from it).
   std::mutex m;
-  uint32_t next = 0;
+  uint64_t next = 0;
   bool aborted = false;
   uint64_t chunks = 0;
   std::vector<double> rates;
   std::thread server;
   bool done = false;  // this rank has had its last grant (or quit)
 
-  SampleShare grant(int rank, double rate) {
+  UnitRange grant(int rank, double rate) {
     std::lock_guard<std::mutex> lock(m);
     if (rate > 0) rates[size_t(rank)] = rate;
     if (aborted) return {next, 0};
@@ -42,9 +42,9 @@ struct SampleDispenser::Impl {
       if (r > 0) known += r, ++measured;
     const double total = measured ? known * double(rates.size()) / double(measured) : 0;
     // One rank (no mpirun): the whole frame at once, as the one-rank build does.
-    const uint32_t count = world.size() == 1 ? spp - next
-                                             : chunk_size(spp - next, spp, world.size(), rates[size_t(rank)], total);
-    const SampleShare s{next, count};
+    const uint64_t count = world.size() == 1 ? units - next
+                                             : chunk_size(units - next, probe, rates[size_t(rank)], total);
+    const UnitRange s{next, count};
     next += count;
     if (count) ++chunks;
     return s;
@@ -63,9 +63,9 @@ struct SampleDispenser::Impl {
       if (st.MPI_TAG == kAsk) {
         double rate = 0;
         MPI_Recv(&rate, 1, MPI_DOUBLE, st.MPI_SOURCE, kAsk, comm, MPI_STATUS_IGNORE);
-        const SampleShare s = grant(st.MPI_SOURCE, rate);
-        const uint32_t g[2] = {s.first, s.count};
-        MPI_Send(g, 2, MPI_UINT32_T, st.MPI_SOURCE, kGrant, comm);
+        const UnitRange s = grant(st.MPI_SOURCE, rate);
+        const uint64_t g[2] = {s.first, s.count};
+        MPI_Send(g, 2, MPI_UINT64_T, st.MPI_SOURCE, kGrant, comm);
         if (s.count == 0) ++finished;
       } else {
         MPI_Recv(nullptr, 0, MPI_BYTE, st.MPI_SOURCE, kQuit, comm, MPI_STATUS_IGNORE);
@@ -77,7 +77,8 @@ struct SampleDispenser::Impl {
   }
 };
 
-SampleDispenser::SampleDispenser(World& world, uint32_t spp) : impl_(std::make_unique<Impl>(world, spp)) {
+SampleDispenser::SampleDispenser(World& world, uint64_t units, uint64_t probe)
+    : impl_(std::make_unique<Impl>(world, units, probe)) {
   impl_->rates.assign(size_t(world.size()), 0.0);
   if (world.root() && world.size() > 1) impl_->server = std::thread([this] { impl_->serve(); });
 }
@@ -86,16 +87,16 @@ SampleDispenser::~SampleDispenser() {
   if (impl_->server.joinable()) impl_->server.join();
 }
 
-SampleShare SampleDispenser::next(double rate) {
+UnitRange SampleDispenser::next(double rate) {
   Impl& d = *impl_;
   if (d.done) return {0, 0};
-  SampleShare s;
+  UnitRange s;
   if (d.world.root()) {
     s = d.grant(0, rate);
   } else {
-    uint32_t g[2] = {0, 0};
+    uint64_t g[2] = {0, 0};
     MPI_Send(&rate, 1, MPI_DOUBLE, 0, kAsk, d.comm);
-    MPI_Recv(g, 2, MPI_UINT32_T, 0, kGrant, d.comm, MPI_STATUS_IGNORE);
+    MPI_Recv(g, 2, MPI_UINT64_T, 0, kGrant, d.comm, MPI_STATUS_IGNORE);
     s = {g[0], g[1]};
   }
   if (s.count == 0) d.done = true;

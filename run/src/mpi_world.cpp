@@ -1,6 +1,6 @@
 // The MPI world (built when PATHBENCH_MPI finds MPI): started on first use when a PMI
 // launcher (mpirun) started this process, one rank otherwise. Collectives for the rank
-// render: failure agreement, string exchange, and the exact film reduction.
+// render: failure agreement and string exchange (the film reduction: mpi_film_reduce.cpp).
 #include <time.h>
 #include <unistd.h>
 
@@ -19,25 +19,6 @@ namespace pb::run {
 namespace {
 World* g_world = nullptr;
 MPI_Comm g_local = MPI_COMM_NULL, g_chunks = MPI_COMM_NULL;
-
-
-// A sum no film holds (|sum| < 2^62 + 2^62): the checked reduction's "overflowed", sticky.
-constexpr int64_t kOverflowed = INT64_MIN;
-void checked_sum(void* in, void* inout, int* len, MPI_Datatype*) {
-  const int64_t* a = static_cast<const int64_t*>(in);
-  int64_t* b = static_cast<int64_t*>(inout);
-  for (int i = 0; i < *len; ++i)
-    if (a[i] == kOverflowed || b[i] == kOverflowed || __builtin_add_overflow(a[i], b[i], &b[i])) b[i] = kOverflowed;
-}
-
-// MPI counts are int: reduce long arrays in pieces.
-template <class T> void reduce_to_root(T* data, size_t n, MPI_Datatype type, MPI_Op op, bool root) {
-  constexpr size_t kPiece = size_t(1) << 28;
-  for (size_t at = 0; at < n; at += kPiece) {
-    const int count = int(std::min(kPiece, n - at));
-    MPI_Reduce(root ? MPI_IN_PLACE : data + at, root ? data + at : nullptr, count, type, op, 0, MPI_COMM_WORLD);
-  }
-}
 
 std::vector<std::string> exchange(const std::string& mine, MPI_Comm comm, bool gather_only) {
   int size = 1, rank = 0;
@@ -129,35 +110,6 @@ std::string World::announce(const std::string& message) {
   return out;
 }
 bool World::can_dispense() const { return !mpi_ || threads_ok_; }
-
-void World::reduce_film(Film& film) {
-  if (!mpi_ || size_ == 1) return;
-  // reduce_film's rules, checked on every rank alike (so that all throw or none does).
-  const std::string shape = fmt::format("{}x{} scale {:a} variance {}", film.width(), film.height(), film.scale(),
-                                        film.has_variance());
-  for (const std::string& other : all(shape))
-    if (other != shape)
-      throw std::invalid_argument(fmt::format("reduce_film: the ranks' films differ ({} vs {})", shape, other));
-  // MPI_SUM cannot overflow where the ranks' largest |sums| add up below 2^63 (every
-  // partial sum is bounded by that); otherwise a checked sum marks overflowed pixels.
-  uint64_t largest = 0;
-  for (int64_t v : film.raw_sums()) largest = std::max(largest, v < 0 ? uint64_t(0) - uint64_t(v) : uint64_t(v));
-  std::vector<uint64_t> largest_all(size_t(size_), 0);
-  MPI_Allgather(&largest, 1, MPI_UINT64_T, largest_all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
-  unsigned __int128 bound = 0;
-  for (uint64_t v : largest_all) bound += v;
-  const bool safe = bound <= (unsigned __int128)INT64_MAX;
-  MPI_Op checked = MPI_OP_NULL;
-  if (!safe) MPI_Op_create(checked_sum, 1, &checked);
-  reduce_to_root(film.raw_sums().data(), film.raw_sums().size(), MPI_INT64_T, safe ? MPI_SUM : checked, root());
-  if (!safe) MPI_Op_free(&checked);
-  // Counts: every sample index of the frame is traced by one rank, so they add up to spp.
-  reduce_to_root(film.counts().data(), film.counts().size(), MPI_UINT32_T, MPI_SUM, root());
-  if (film.has_variance()) reduce_to_root(film.raw_sum_sq().data(), film.raw_sum_sq().size(), MPI_DOUBLE, MPI_SUM, root());
-  if (!safe && root())
-    for (int64_t v : film.raw_sums())
-      if (v == kOverflowed) throw std::overflow_error("reduce_film: a pixel sum overflows");
-}
 
 int World::end(int code) {
   if (!g_world || !g_world->mpi_) return code;

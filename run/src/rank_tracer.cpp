@@ -22,6 +22,7 @@ struct RankTracer::Gpu {
 #if PATHBENCH_HAVE_CUDA
   explicit Gpu(const Scene& s) : scene(s) {}
   gpu::GpuScene scene;
+  gpu::DeviceFilm film;  // every block's samples, downloaded once (finish)
 #endif
 };
 
@@ -49,10 +50,12 @@ const char* RankTracer::tracer() const {
   return cpu_->gpu_bvh ? "gpu-bvh-on-host" : "embree";
 }
 
-void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
+void RankTracer::trace(const FrameBlock& block, Film& film, RunReport& report) {
   RenderSettings s = settings_;
-  s.first_sample = share.first;
-  s.sample_count = share.count;
+  s.first_row = block.first_row;
+  s.row_count = block.rows;
+  s.first_sample = block.first_sample;
+  s.sample_count = block.samples;
   s.progress = false;  // ranks' bars would interleave on one terminal
   RunReport chunk;
   if (s.device == Device::Cpu && cpu_->gpu_bvh) {
@@ -68,21 +71,8 @@ void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
     cpu::render(scene_, *cpu_->scene, s, film, chunk);  // Film::add accumulates into the rank's film
   } else {
 #if PATHBENCH_HAVE_CUDA
-    // The device's film comes back whole, replacing the host's: the first chunk lands in
-    // the rank's film (begun, so zero), later ones in a scratch film added to it. A static
-    // split (one chunk) thus costs no extra copy or addition.
-    if (chunks_ == 0) {
-      gpu::render(scene_, gpu_->scene, s, film, chunk, options_.profile);
-    } else {
-      // Begun once, for the frame's scale: every download replaces all its sums and counts.
-      if (scratch_.width() != film.width() || scratch_.height() != film.height() ||
-          scratch_.has_variance() != film.has_variance()) {
-        scratch_ = Film(film.width(), film.height(), film.has_variance());
-        scratch_.begin(s.spp, scene_.max_emission());
-      }
-      gpu::render(scene_, gpu_->scene, s, scratch_, chunk, options_.profile);
-      reduce_film(film, scratch_);
-    }
+    // Every block adds into the device's film; it comes back once, in finish().
+    gpu::render(scene_, gpu_->scene, s, film, chunk, options_.profile, &gpu_->film);
 #endif
   }
   // The first chunk's description (device, memory, layout) stands for the rank's;
@@ -100,7 +90,15 @@ void RankTracer::trace(SampleShare share, Film& film, RunReport& report) {
   report.seconds += chunk.seconds;
   report.device_seconds += chunk.device_seconds;
   report.peak_device_bytes = std::max(report.peak_device_bytes, chunk.peak_device_bytes);
-  report.tracer_host_bytes = std::max(report.tracer_host_bytes, chunk.tracer_host_bytes + scratch_.bytes());
+  report.tracer_host_bytes = std::max(report.tracer_host_bytes, chunk.tracer_host_bytes);
+}
+
+void RankTracer::finish(Film& film, RunReport& report) {
+#if PATHBENCH_HAVE_CUDA
+  if (gpu_ && gpu_->film.used()) report.extra["film_download_seconds"] = gpu_->film.download(film);
+#else
+  (void)film, (void)report;
+#endif
 }
 
 }  // namespace pb::run

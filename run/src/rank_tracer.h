@@ -22,18 +22,20 @@ class RankTracer {
   // What traces this rank's samples: "embree", "gpu", or "gpu-bvh-on-host".
   const char* tracer() const;
   ~RankTracer();
-  // Traces samples `share` of every pixel into `film` (begun for the whole frame, and
-  // holding nothing but this tracer's earlier chunks), and adds the chunk's rays, paths,
-  // discarded samples and times into `report`.
-  void trace(SampleShare share, Film& film, RunReport& report);
+  // Traces `block` of the frame into `film` (begun for the whole frame, and holding
+  // nothing but this tracer's earlier blocks), and adds the block's rays, paths,
+  // discarded samples and times into `report`. A GPU rank's blocks add up on the device
+  // until finish().
+  void trace(const FrameBlock& block, Film& film, RunReport& report);
+  // After the rank's last block: a GPU rank's film comes back from the device (once).
+  void finish(Film& film, RunReport& report);
 
  private:
   const Scene& scene_;
   RenderSettings settings_;
   RunOptions options_;
-  Film scratch_;  // GPU: the device's film comes back whole, so later chunks land here first
   struct Cpu;  // the Embree scene, or the GPU's BVH on the host
-  struct Gpu;  // the uploaded scene and BVH
+  struct Gpu;  // the uploaded scene and BVH, and the film on the device
   std::unique_ptr<Cpu> cpu_;
   std::unique_ptr<Gpu> gpu_;
   int chunks_ = 0;

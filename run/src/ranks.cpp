@@ -22,37 +22,86 @@ SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp) {
   return {first, base + (rank < extra ? 1u : 0u)};
 }
 
+std::vector<FrameBlock> blocks_of(UnitRange range, uint32_t spp, uint32_t rows) {
+  if (spp == 0 || range.first > uint64_t(rows) * spp || range.count > uint64_t(rows) * spp - range.first)
+    throw std::invalid_argument("blocks_of: the range leaves the frame");
+  std::vector<FrameBlock> blocks;
+  uint64_t u = range.first;
+  const uint64_t end = range.first + range.count;
+  while (u < end) {
+    const uint32_t row = uint32_t(u / spp), sample = uint32_t(u % spp);
+    if (sample != 0 || end - u < spp) {  // part of one row: to its end or to the range's
+      const uint32_t n = uint32_t(std::min<uint64_t>(spp - sample, end - u));
+      blocks.push_back({row, 1, sample, n});
+      u += n;
+    } else {  // whole rows
+      const uint32_t n = uint32_t((end - u) / spp);
+      blocks.push_back({row, n, 0, spp});
+      u += uint64_t(n) * spp;
+    }
+  }
+  return blocks;
+}
+
+void add_rows(std::vector<RowRange>& rows, const FrameBlock& block) {
+  if (block.rows == 0 || block.samples == 0) return;
+  RowRange r{block.first_row, block.rows};
+  auto it = std::lower_bound(rows.begin(), rows.end(), r, [](const RowRange& a, const RowRange& b) { return a.first < b.first; });
+  it = rows.insert(it, r);
+  // Merge with the neighbours it touches or overlaps.
+  if (it != rows.begin()) {
+    auto prev = it - 1;
+    if (uint64_t(prev->first) + prev->count >= it->first) {
+      const uint64_t e = std::max(uint64_t(prev->first) + prev->count, uint64_t(it->first) + it->count);
+      prev->count = uint32_t(e - prev->first);
+      it = rows.erase(it) - 1;
+    }
+  }
+  while (it + 1 != rows.end() && uint64_t(it->first) + it->count >= (it + 1)->first) {
+    const uint64_t e = std::max(uint64_t(it->first) + it->count, uint64_t((it + 1)->first) + (it + 1)->count);
+    it->count = uint32_t(e - it->first);
+    rows.erase(it + 1);
+  }
+}
+
+bool add_rows_into(Film& into, uint32_t first_row, uint32_t rows, const int64_t* sums, const uint32_t* counts,
+                   const double* sum_sq) {
+  if (uint64_t(first_row) + rows > into.height()) throw std::invalid_argument("add_rows_into: rows outside the film");
+  const size_t px0 = size_t(first_row) * into.width(), px = size_t(rows) * into.width();
+  bool ok = true;
+  int64_t* sum = into.raw_sums().data() + px0 * 3;
+  for (size_t i = 0; i < px * 3; ++i) ok &= !__builtin_add_overflow(sum[i], sums[i], &sum[i]);
+  uint32_t* count = into.counts().data() + px0;
+  for (size_t i = 0; i < px; ++i) ok &= !__builtin_add_overflow(count[i], counts[i], &count[i]);
+  if (into.has_variance() && sum_sq) {
+    double* sq = into.raw_sum_sq().data() + px0 * 3;
+    for (size_t i = 0; i < px * 3; ++i) sq[i] += sum_sq[i];
+  }
+  return ok;
+}
+
 void reduce_film(Film& into, const Film& part) {
   if (into.width() != part.width() || into.height() != part.height() || into.scale() != part.scale() ||
       into.has_variance() != part.has_variance())
     throw std::invalid_argument("reduce_film: the films differ in size, scale or variance");
-  auto& sum = into.raw_sums();
-  const auto& add = part.raw_sums();
-  for (size_t i = 0; i < sum.size(); ++i)
-    if (__builtin_add_overflow(sum[i], add[i], &sum[i])) throw std::overflow_error("reduce_film: a pixel sum overflows");
-  auto& count = into.counts();
-  for (size_t i = 0; i < count.size(); ++i)
-    if (__builtin_add_overflow(count[i], part.counts()[i], &count[i]))
-      throw std::overflow_error("reduce_film: a pixel's sample count overflows");
-  if (into.has_variance()) {
-    auto& sq = into.raw_sum_sq();
-    const auto& sq_add = part.raw_sum_sq();
-    for (size_t i = 0; i < sq.size(); ++i) sq[i] += sq_add[i];
-  }
+  if (!add_rows_into(into, 0, into.height(), part.raw_sums().data(), part.counts().data(),
+                     part.has_variance() ? part.raw_sum_sq().data() : nullptr))
+    throw std::overflow_error("reduce_film: a pixel sum or sample count overflows");
 }
 
-uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, double total_rate) {
-  (void)spp, (void)ranks;
+uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double total_rate) {
   if (remaining == 0) return 0;
-  // Not measured yet: a probe of one sample per pixel (a CPU rank's first chunk must not
-  // outlast a GPU's whole frame). Then a fraction f of what is left, shared by rate: every
-  // rank's chunk ends after about f of the frame's remaining time, whoever it is, so ranks
-  // finish close together. f grows from 3/4 with the rank's share of the rate, so that a
-  // dominant rank (a GPU beside CPUs, whose every call costs a warm-up frame and a film
-  // copy) needs few chunks, and slow ranks take the smaller ones at the end.
+  // Not measured yet: a probe (one sample per pixel's worth of units: a CPU rank's first
+  // chunk must not outlast a GPU's whole frame). Then a fraction f of what is left, shared
+  // by rate: every rank's chunk ends after about f of the frame's remaining time, whoever
+  // it is, so ranks finish close together. f grows from 3/4 with the rank's share of the
+  // rate, so that a dominant rank (a GPU beside CPUs, whose every call costs kernel
+  // launches and a partly idle device at its end) needs few chunks, and slow ranks take
+  // the smaller ones at the end.
   const double share = rate > 0 && total_rate > 0 ? std::min(1.0, rate / total_rate) : 0.0;
-  const double want = share > 0 ? std::ceil((0.75 + 0.2 * share) * share * double(remaining)) : 1.0;
-  return uint32_t(std::min<double>(std::max(want, 1.0), remaining));
+  const double want = share > 0 ? std::ceil((0.75 + 0.2 * share) * share * double(remaining))
+                                : double(std::max<uint64_t>(probe, 1));
+  return uint64_t(std::min<double>(std::max(want, 1.0), double(remaining)));
 }
 
 }  // namespace pb::run

@@ -159,26 +159,36 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   const nlohmann::json load0 = load_sample();
   RunReport mine;
   RankFailure failed;
-  uint32_t samples = 0;
+  uint64_t samples = 0;           // (pixel, sample) pairs this rank traced
+  std::vector<RowRange> rows;     // dynamic: the rows this rank traced (all its film holds)
   int chunks = 0;
   uint64_t granted = 0;  // rank 0, dynamic: chunks handed out in all
+  auto trace = [&](const FrameBlock& b) {
+    tracer->trace(b, film, mine);
+    samples += uint64_t(b.rows) * s.width * b.samples;
+    add_rows(rows, b);
+  };
   {
-    std::optional<SampleDispenser> dispenser;  // dynamic balancing only: rank 0 then serves it
-    if (balance == Balance::Dynamic) dispenser.emplace(w, s.spp);
+    // Dynamic balancing only: rank 0 then serves it. Its units are rows x samples, and a
+    // rank's first chunk (its probe) one unit a row: a sample per pixel's worth.
+    std::optional<SampleDispenser> dispenser;
+    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, uint64_t(s.height));
     try {
       if (balance == Balance::Static) {
         const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
-        if (share.count) tracer->trace(share, film, mine), samples += share.count, ++chunks;
+        if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
+        uint64_t units = 0;
         for (;;) {
-          const double rate = mine.seconds > 0 ? double(samples) / mine.seconds : 0.0;
-          const SampleShare share = dispenser->next(rate);
-          if (share.count == 0) break;
-          tracer->trace(share, film, mine);
-          samples += share.count;
+          const double rate = mine.seconds > 0 ? double(units) / mine.seconds : 0.0;
+          const UnitRange range = dispenser->next(rate);
+          if (range.count == 0) break;
+          for (const FrameBlock& b : blocks_of(range, s.spp, s.height)) trace(b);
+          units += range.count;
           ++chunks;
         }
       }
+      tracer->finish(film, mine);
     } catch (...) {
       failed = failure_of(std::current_exception(), w.rank());
       if (dispenser) dispenser->abort();
@@ -189,7 +199,9 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   }
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
-  on_every_rank([&] { w.reduce_film(film); });
+  // A static split's ranks each hold every pixel (MPI_Reduce); dynamic chunks' ranks hold
+  // bands of rows, and only those travel.
+  on_every_rank([&] { balance == Balance::Dynamic ? w.reduce_film_rows(film, rows) : w.reduce_film(film); });
   const double reduce_seconds = since(r0), frame_seconds = since(t0);
 
   // 4. One report, on rank 0.

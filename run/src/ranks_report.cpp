@@ -9,7 +9,7 @@
 namespace pb::run {
 
 nlohmann::json rank_entry(int rank, const std::string& host, const RenderSettings& s, const RunReport& r,
-                          int gpu_index, uint32_t samples_per_pixel, int chunks, double wall_seconds) {
+                          int gpu_index, uint64_t samples, int chunks, double wall_seconds) {
   const bool gpu = s.device == Device::Gpu;
   std::string name = cpu_model();
   if (gpu && r.extra.contains("gpu")) name = r.extra["gpu"].value("name", name);
@@ -22,7 +22,8 @@ nlohmann::json rank_entry(int rank, const std::string& host, const RenderSetting
           {"tracer", gpu ? std::string("gpu") : r.extra.value("tracer", std::string("embree"))},
           {"gpu_index", gpu_index >= 0 ? nlohmann::json(gpu_index) : nlohmann::json(nullptr)},
           {"threads", gpu ? nlohmann::json(nullptr) : nlohmann::json(r.threads)},
-          {"samples_per_pixel", samples_per_pixel},
+          {"samples", samples},  // (pixel, sample) pairs traced
+          {"samples_per_pixel", double(samples) / (double(s.width) * s.height)},
           {"chunks", chunks},
           // Host wall clock of the tracer calls (GPU: with each call's warm-up and copies).
           {"tracer_seconds", r.seconds},
@@ -57,9 +58,9 @@ void merge_ranks(RunReport& report, const std::vector<std::string>& ranks, doubl
     const double busy = e["tracer_seconds"].get<double>();
     busy_sum += busy;
     busy_max = std::max(busy_max, busy);
-    const uint64_t spp = e["samples_per_pixel"].get<uint64_t>();
-    spp_sum += spp;
-    by_device[e["device"].get<std::string>()] += spp;
+    const uint64_t traced = e["samples"].get<uint64_t>();
+    spp_sum += traced;
+    by_device[e["device"].get<std::string>()] += traced;
     per_rank.push_back(std::move(e));
   }
   const double n = double(std::max<size_t>(1, ranks.size()));

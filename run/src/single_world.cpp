@@ -31,20 +31,21 @@ std::vector<std::string> World::local_all(const std::string& mine) { return {min
 void World::barrier() {}
 std::string World::announce(const std::string& message) { return message; }
 void World::reduce_film(Film&) {}
+void World::reduce_film_rows(Film&, const std::vector<RowRange>&) {}
 bool World::can_dispense() const { return true; }
 int World::end(int code) { return code; }  // no MPI: nothing to end
 
 struct SampleDispenser::Impl {
-  uint32_t spp, next = 0;
+  uint64_t units, next = 0;
 };
-SampleDispenser::SampleDispenser(World&, uint32_t spp) : impl_(std::make_unique<Impl>(Impl{spp})) {}
+SampleDispenser::SampleDispenser(World&, uint64_t units, uint64_t) : impl_(std::make_unique<Impl>(Impl{units})) {}
 SampleDispenser::~SampleDispenser() = default;
-SampleShare SampleDispenser::next(double) {
-  const SampleShare s{impl_->next, impl_->spp - impl_->next};
-  impl_->next = impl_->spp;
+UnitRange SampleDispenser::next(double) {
+  const UnitRange s{impl_->next, impl_->units - impl_->next};
+  impl_->next = impl_->units;
   return s;
 }
-void SampleDispenser::abort() { impl_->next = impl_->spp; }
+void SampleDispenser::abort() { impl_->next = impl_->units; }
 void SampleDispenser::finish() {}
 uint64_t SampleDispenser::chunks_granted() const { return impl_->next > 0 ? 1 : 0; }
 

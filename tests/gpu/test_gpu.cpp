@@ -197,6 +197,40 @@ TEST(HostGpuTracer, SameFilmAsTheGpu) {
   host_tracer_vs_gpu("paper-cornell", Sampling::Nee, 2, Precision::Double);
 }
 
+// An MPI rank's chunks (run/rank_tracer.cpp): blocks of rows x samples added into one
+// film kept on the device, downloaded once, give the whole render's film byte for byte.
+TEST(DeviceFilm, BlocksAddUpToTheWholeFrame) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  const GpuScene gpu_scene(scene);
+  for (Strategy strategy : {Strategy::Pixel, Strategy::Wavefront, Strategy::PaperQueue}) {
+    const RenderSettings s = small_settings(strategy, 48, 16);
+    Film whole(s.width, s.height, false);
+    whole.begin(s.spp, scene.max_emission());
+    RunReport wr;
+    render(scene, gpu_scene, s, whole, wr);
+    Film kept(s.width, s.height, false);
+    kept.begin(s.spp, scene.max_emission());
+    DeviceFilm device_film;
+    EXPECT_FALSE(device_film.used());
+    uint64_t paths = 0;
+    // {first_row, rows, first_sample, samples}: all rows' first samples, then bands.
+    const uint32_t blocks[][4] = {{0, 48, 0, 3}, {0, 10, 3, 13}, {10, 1, 3, 7}, {10, 1, 10, 6}, {11, 37, 3, 13}};
+    for (const auto& b : blocks) {
+      RenderSettings c = s;
+      c.first_row = b[0], c.row_count = b[1], c.first_sample = b[2], c.sample_count = b[3];
+      RunReport r;
+      render(scene, gpu_scene, c, kept, r, false, &device_film);
+      paths += r.paths;
+    }
+    EXPECT_EQ(kept.counts(), std::vector<uint32_t>(kept.counts().size(), 0u)) << "the host film is left alone";
+    EXPECT_GE(device_film.download(kept), 0.0);
+    EXPECT_EQ(paths, wr.paths);
+    expect_identical(whole, kept, to_string(strategy));
+    EXPECT_EQ(whole.counts(), kept.counts());
+  }
+}
+
 TEST(GpuVsCpu, PaperCornell) {
   PB_REQUIRE_GPU();
   gpu_vs_cpu("paper-cornell");

@@ -10,6 +10,7 @@
 
 #include "pathbench/common/scene_library.h"
 #include "pathbench/gpu/host_tracer.h"
+#include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 
 namespace pb::gpu {
@@ -27,14 +28,17 @@ RenderSettings settings(uint32_t size, uint32_t spp) {
   return s;
 }
 
+// Blocks {first_row, rows (0: to the end), first_sample, samples} traced into one film.
 Film host_film(const Scene& scene, const HostGpuTracer& t, const RenderSettings& s,
-               std::initializer_list<std::pair<uint32_t, uint32_t>> chunks, RunReport& r) {
+               std::initializer_list<run::FrameBlock> blocks, RunReport& r) {
   Film f(s.width, s.height, false);
   f.begin(s.spp, scene.max_emission());
-  for (auto [first, count] : chunks) {
+  for (const run::FrameBlock& b : blocks) {
     RenderSettings c = s;
-    c.first_sample = first;
-    c.sample_count = count;
+    c.first_row = b.first_row;
+    c.row_count = b.rows;
+    c.first_sample = b.first_sample;
+    c.sample_count = b.samples;
     t.render(c, f, r);
   }
   return f;
@@ -45,10 +49,12 @@ TEST(HostGpuTracer, ExactUnderAnySplitOfSamplesAndThreads) {
   const HostGpuTracer tracer(scene);
   RenderSettings s = settings(24, 16);
   RunReport whole_r, split_r, one_r;
-  const Film whole = host_film(scene, tracer, s, {{0, 16}}, whole_r);
-  const Film split = host_film(scene, tracer, s, {{0, 5}, {5, 1}, {6, 10}}, split_r);
+  const Film whole = host_film(scene, tracer, s, {{0, 0, 0, 16}}, whole_r);
+  // Sample ranges of every row, and blocks of rows (a dynamic chunk's: run/ranks.h).
+  const Film split = host_film(scene, tracer, s, {{0, 0, 0, 5}, {0, 0, 5, 1}, {0, 7, 6, 10}, {7, 1, 6, 3},
+                                                  {7, 1, 9, 7}, {8, 0, 6, 10}}, split_r);
   s.threads = 1;
-  const Film one_thread = host_film(scene, tracer, s, {{0, 16}}, one_r);
+  const Film one_thread = host_film(scene, tracer, s, {{0, 0, 0, 16}}, one_r);
   EXPECT_EQ(whole.raw_sums(), split.raw_sums());
   EXPECT_EQ(whole.counts(), split.counts());
   EXPECT_EQ(whole.raw_sums(), one_thread.raw_sums());
@@ -63,7 +69,7 @@ TEST(HostGpuTracer, RendersWhatTheCpuTracerRenders) {
     const Scene scene = load_scene(name);
     const RenderSettings s = settings(32, 16);
     RunReport hr, cr;
-    const Film host = host_film(scene, HostGpuTracer(scene), s, {{0, 16}}, hr);
+    const Film host = host_film(scene, HostGpuTracer(scene), s, {{0, 0, 0, 16}}, hr);
     Film cpu(s.width, s.height, false);
     run::render(scene, s, cpu, cr);
     const auto a = host.mean(), b = cpu.mean();

@@ -50,6 +50,71 @@ void expect_split_equals_whole(const RenderSettings& whole, const std::vector<ui
   EXPECT_EQ(sum.raw_sums(), one.film.raw_sums());  // bit for bit, not "close"
 }
 
+// Films of the dynamic chunks `cuts` (unit indices: row-major rows x spp, run/ranks.h)
+// traced block by block, reduced row band by row band, against one film of the frame.
+void expect_chunks_equal_whole(const RenderSettings& whole, const std::vector<uint64_t>& cuts) {
+  const Scene scene = make_paper_cornell();
+  const run::Rendered one = run::render(scene, whole);
+  Film sum(whole.width, whole.height, false);
+  sum.begin(whole.spp, scene.max_emission());
+  uint64_t paths = 0;
+  const size_t w = whole.width;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i)
+    for (const run::FrameBlock& b : run::blocks_of({cuts[i], cuts[i + 1] - cuts[i]}, whole.spp, whole.height)) {
+      RenderSettings s = whole;
+      s.first_row = b.first_row;
+      s.row_count = b.rows;
+      s.first_sample = b.first_sample;
+      s.sample_count = b.samples;
+      const run::Rendered part = run::render(scene, s);
+      paths += part.report.paths;
+      // Only the block's rows are added (as World::reduce_film_rows sends a rank's rows).
+      ASSERT_TRUE(run::add_rows_into(sum, b.first_row, b.rows, part.film.raw_sums().data() + b.first_row * w * 3,
+                                     part.film.counts().data() + b.first_row * w, nullptr));
+    }
+  EXPECT_EQ(paths, one.report.paths);
+  EXPECT_EQ(sum.counts(), one.film.counts());
+  EXPECT_EQ(sum.raw_sums(), one.film.raw_sums());  // bit for bit
+}
+
+TEST(RankSplit, BlocksOfAUnitRange) {
+  using B = run::FrameBlock;
+  // 12 rows x 11 spp: units 5..40 = row 0 samples 5..10, rows 1-2 whole, row 3 samples 0..6.
+  EXPECT_EQ(run::blocks_of({5, 35}, 11, 12), (std::vector<B>{{0, 1, 5, 6}, {1, 2, 0, 11}, {3, 1, 0, 7}}));
+  EXPECT_EQ(run::blocks_of({0, 132}, 11, 12), (std::vector<B>{{0, 12, 0, 11}}));
+  EXPECT_EQ(run::blocks_of({13, 3}, 11, 12), (std::vector<B>{{1, 1, 2, 3}}));
+  EXPECT_EQ(run::blocks_of({22, 11}, 11, 12), (std::vector<B>{{2, 1, 0, 11}}));
+  EXPECT_TRUE(run::blocks_of({7, 0}, 11, 12).empty());
+  EXPECT_THROW(run::blocks_of({130, 3}, 11, 12), std::invalid_argument);
+  // Row ranges merge where they touch or overlap.
+  std::vector<run::RowRange> rows;
+  run::add_rows(rows, {5, 2, 0, 11});
+  run::add_rows(rows, {0, 1, 3, 2});
+  run::add_rows(rows, {7, 1, 0, 4});
+  run::add_rows(rows, {6, 1, 0, 4});
+  EXPECT_EQ(rows, (std::vector<run::RowRange>{{0, 1}, {5, 3}}));
+  run::add_rows(rows, {1, 4, 0, 1});
+  EXPECT_EQ(rows, (std::vector<run::RowRange>{{0, 8}}));
+}
+
+TEST(RankSplit, ChunksOfRowsGiveTheSameFilm) {
+  // 12 rows x 11 spp = 132 units, cut across rows and inside them.
+  expect_chunks_equal_whole(small(Strategy::Pixel, Isa::Auto), {0, 1, 12, 40, 41, 99, 132});
+  expect_chunks_equal_whole(small(Strategy::Pixel, Isa::Scalar), {0, 66, 70, 132});
+  expect_chunks_equal_whole(small(Strategy::Wavefront, Isa::Auto), {0, 5, 17, 23, 131, 132});
+  expect_chunks_equal_whole(small(Strategy::Wavefront, Isa::Scalar), {0, 12, 132});
+}
+
+TEST(RankSplit, RowRangeOutsideTheFrameIsABug) {
+  RenderSettings s = small(Strategy::Pixel, Isa::Auto);
+  s.first_row = 10;
+  s.row_count = 3;
+  EXPECT_THROW(s.validate(), std::invalid_argument);
+  s.first_row = 12;
+  s.row_count = 0;
+  EXPECT_THROW(s.validate(), std::invalid_argument);
+}
+
 TEST(RankSplit, PixelStrategyAnySplitGivesTheSameFilm) {
   expect_split_equals_whole(small(Strategy::Pixel, Isa::Auto), {0, 3, 4, 11});
   expect_split_equals_whole(small(Strategy::Pixel, Isa::Scalar), {0, 5, 11});
@@ -71,25 +136,28 @@ TEST(RankSplit, RangeOutsideTheFrameIsABug) {
 }
 
 TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
-  // Unmeasured: a probe of one sample per pixel.
-  EXPECT_EQ(run::chunk_size(1024, 1024, 2, 0, 0), 1u);
+  // Unmeasured: the probe.
+  EXPECT_EQ(run::chunk_size(1024, 12, 0, 0), 12u);
+  EXPECT_EQ(run::chunk_size(5, 12, 0, 0), 5u);
   // A rank with 3/4 of the total rate gets (3/4 + 0.2 x 3/4) x 3/4 of what is left.
-  EXPECT_EQ(run::chunk_size(800, 1024, 2, 3.0, 4.0), 540u);
+  EXPECT_EQ(run::chunk_size(800, 12, 3.0, 4.0), 540u);
   // Never more than is left, never less than one.
-  EXPECT_EQ(run::chunk_size(5, 1024, 2, 100.0, 100.0), 5u);
-  EXPECT_EQ(run::chunk_size(500, 1024, 2, 1.0, 1000.0), 1u);
-  EXPECT_EQ(run::chunk_size(0, 1024, 2, 1.0, 1.0), 0u);
+  EXPECT_EQ(run::chunk_size(5, 12, 100.0, 100.0), 5u);
+  EXPECT_EQ(run::chunk_size(500, 12, 1.0, 1000.0), 1u);
+  EXPECT_EQ(run::chunk_size(0, 12, 1.0, 1.0), 0u);
+  // Beyond 32 bits (a 65536-row frame at 2^17 spp).
+  EXPECT_EQ(run::chunk_size(uint64_t(1) << 33, 12, 1.0, 1.0), uint64_t(0.95 * double(uint64_t(1) << 33)) + 1);
   // A GPU 30x a CPU, each asking when its chunk would end: the frame is covered exactly,
   // the GPU needs few chunks, and the CPU's work ends no later than the GPU's.
   const double rate[2] = {30.0, 1.0};
   double busy_until[2] = {0, 0};
-  uint32_t next = 0, chunks[2] = {0, 0};
+  uint64_t next = 0, chunks[2] = {0, 0};
   while (next < 1024) {
     const int r = busy_until[0] <= busy_until[1] ? 0 : 1;
-    const uint32_t c = run::chunk_size(1024 - next, 1024, 2, rate[r], 31.0);
+    const uint64_t c = run::chunk_size(1024 - next, 1, rate[r], 31.0);
     ASSERT_GT(c, 0u);
     next += c;
-    busy_until[r] += c / rate[r];
+    busy_until[r] += double(c) / rate[r];
     ++chunks[r];
   }
   EXPECT_EQ(next, 1024u);
@@ -102,8 +170,8 @@ TEST(RankSplit, OneProcessIsOneRank) {
   EXPECT_EQ(w.size(), 1);
   EXPECT_TRUE(w.root());
   // Whole-frame dispensing in one rank: everything, then nothing.
-  run::SampleDispenser d(w, 9);
-  const run::SampleShare a = d.next(0);
+  run::SampleDispenser d(w, 9, 2);
+  const run::UnitRange a = d.next(0);
   EXPECT_EQ(a.first, 0u);
   EXPECT_EQ(a.count, 9u);
   EXPECT_EQ(d.next(1.0).count, 0u);
@@ -132,8 +200,8 @@ TEST(RankSplit, MergedReportSumsRanksAndMeasuresBalance) {
   RunReport r0, r1;
   r0.rays.camera = 100, r0.paths = 100, r0.seconds = 2.0, r0.threads = 4;
   r1.rays.camera = 50, r1.rays.shadow = 10, r1.paths = 50, r1.seconds = 1.0, r1.threads = 4;
-  const std::vector<std::string> entries = {run::rank_entry(0, "a", s, r0, -1, 8, 1, 2.1).dump(),
-                                            run::rank_entry(1, "b", s, r1, -1, 3, 2, 2.1).dump()};
+  const std::vector<std::string> entries = {run::rank_entry(0, "a", s, r0, -1, 8 * 16 * 12, 1, 2.1).dump(),
+                                            run::rank_entry(1, "b", s, r1, -1, 3 * 16 * 12, 2, 2.1).dump()};
   RunReport merged = r0;
   merged.settings = s;
   run::merge_ranks(merged, entries, 2.5, 0.1, "dynamic");
@@ -145,7 +213,8 @@ TEST(RankSplit, MergedReportSumsRanksAndMeasuresBalance) {
   EXPECT_DOUBLE_EQ(x["load_balance"].get<double>(), 2.0 / 1.5);               // max / mean
   EXPECT_DOUBLE_EQ(x["parallel_efficiency"].get<double>(), 3.0 / (2 * 2.5));  // busy / (N x frame)
   EXPECT_DOUBLE_EQ(x["device_share"]["cpu"].get<double>(), 1.0);
-  EXPECT_EQ(x["per_rank"][1]["samples_per_pixel"], 3);
+  EXPECT_DOUBLE_EQ(x["per_rank"][1]["samples_per_pixel"].get<double>(), 3.0);
+  EXPECT_EQ(x["per_rank"][1]["samples"], 3 * 16 * 12);
 }
 
 }  // namespace

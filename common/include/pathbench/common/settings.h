@@ -40,6 +40,9 @@ struct PathConfig {
   // The first sample index this render traces (RenderSettings::first_sample): a sample's
   // index, not its rank or chunk, keys the random stream.
   uint32_t first_sample = 0;
+  // The first pixel this render traces (RenderSettings::first_row x width): the traced
+  // pixels are [first_pixel, first_pixel + width x traced rows), whole rows.
+  uint32_t first_pixel = 0;
 };
 
 struct RenderSettings {
@@ -65,13 +68,19 @@ struct RenderSettings {
   // share or chunk (run/ranks.h); the film is begun for the whole frame's spp either way,
   // and the random stream is keyed by pixel and sample, so any split gives the same image.
   uint32_t first_sample = 0, sample_count = 0;
+  // Likewise the rows traced: [first_row, first_row + traced_rows()); row_count 0 = the
+  // rest of the frame. Set by the run layer for a dynamic chunk (run/ranks.h FrameBlock).
+  uint32_t first_row = 0, row_count = 0;
 
   PathConfig path_config() const {
-    return {max_bounces, sampling, russian_roulette, rr_start_depth, width, height, seed, first_sample};
+    return {max_bounces, sampling, russian_roulette, rr_start_depth, width, height, seed, first_sample,
+            first_row * width};
   }
   uint64_t total_samples() const { return uint64_t(width) * height * spp; }
   uint32_t traced_spp() const { return sample_count ? sample_count : spp - first_sample; }
-  uint64_t traced_samples() const { return uint64_t(width) * height * traced_spp(); }
+  uint32_t traced_rows() const { return row_count ? row_count : height - first_row; }
+  uint32_t traced_pixels() const { return width * traced_rows(); }
+  uint64_t traced_samples() const { return uint64_t(traced_pixels()) * traced_spp(); }
   // Throws InputError (naming the offending option) on impossible settings.
   void validate() const;
 };

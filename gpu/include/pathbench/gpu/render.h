@@ -60,6 +60,27 @@ class GpuScene {
   std::unique_ptr<Impl> impl_;
 };
 
+// A film kept on the device across renders: an MPI rank's chunks (run/rank_tracer.cpp)
+// add into it, and it comes back to the host once, instead of a film copy and a host-side
+// addition per chunk. Its first render warms up (as every render does); later ones add.
+class DeviceFilm {
+ public:
+  DeviceFilm();
+  ~DeviceFilm();
+  DeviceFilm(const DeviceFilm&) = delete;
+  DeviceFilm& operator=(const DeviceFilm&) = delete;
+  // Whether a render has added into it yet.
+  bool used() const;
+  // Replaces `film`'s sums and counts (and variance sums) with the device's: the sums of
+  // every render into it. Returns the seconds the copy took.
+  double download(Film& film) const;
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 // Traces into `film` and fills the GPU's fields of `report`. Called by the run layer
 // (pathbench/run/run.h), which has validated the settings, checked the device, sized
 // and begun the film, and fills the common report fields. `profile`
@@ -68,7 +89,9 @@ class GpuScene {
 // run, or device memory too small for the request (naming the setting to lower).
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile = false);
 void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
-            RunReport& report, bool profile = false);
+            RunReport& report, bool profile = false, DeviceFilm* keep = nullptr);
+// With `keep`, the samples are added into that device film (sized for `film` on its first
+// use) and `film` is left untouched: DeviceFilm::download brings the sums back.
 
 // Default pool size of the wavefront strategy on this device.
 uint64_t default_paths_in_flight();

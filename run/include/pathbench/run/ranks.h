@@ -3,6 +3,7 @@
 // that it is tested in every build: a rank's share of each pixel's samples, and the
 // exact reduction of the rank films' integer sums.
 #include <cstdint>
+#include <vector>
 
 #include "pathbench/common/film.h"
 
@@ -17,10 +18,42 @@ struct SampleShare {
 // sample more. Throws std::invalid_argument for rank >= ranks or ranks == 0.
 SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp);
 
+// A block of the frame a tracer call traces: samples [first_sample, first_sample +
+// samples) of every pixel of rows [first_row, first_row + rows).
+struct FrameBlock {
+  uint32_t first_row = 0, rows = 0, first_sample = 0, samples = 0;
+  bool operator==(const FrameBlock&) const = default;
+};
+
+// Dynamic balancing hands out ranges of the frame's units, row-major: unit u is sample
+// u % spp of every pixel of row u / spp. A range is thus mostly whole rows (all their
+// samples), so a rank's part of the film is a band of rows and only those rows travel
+// to rank 0 (World::reduce_film_rows); a GPU beside CPUs sends nothing it did not trace.
+struct UnitRange {
+  uint64_t first = 0, count = 0;
+};
+// The blocks of a range (at most three: a part row, whole rows, a part row), in order.
+// Throws std::invalid_argument for a range outside rows x spp units.
+std::vector<FrameBlock> blocks_of(UnitRange range, uint32_t spp, uint32_t rows);
+
+// Rows [first, first + count): what a rank traced of the frame, merged and in order.
+struct RowRange {
+  uint32_t first = 0, count = 0;
+  bool operator==(const RowRange&) const = default;
+};
+// Adds `block`'s rows to `rows` (sorted, merged where they touch or overlap).
+void add_rows(std::vector<RowRange>& rows, const FrameBlock& block);
+
 // Adds `part`'s sums, counts and variance sums into `into` (same size, same scale: both
 // begun for the whole frame). Integer sums: exact and order-free. Throws
 // std::invalid_argument when the films do not match, std::overflow_error when a sum
 // would leave Film's range (|sum| < 2^62 + 2^62).
 void reduce_film(Film& into, const Film& part);
+// The same for rows [first_row, first_row + rows) alone, `part` holding those rows' sums,
+// counts and (where kept) variance sums in Film's order (pixel-major, 3 channels):
+// `sums` 3 x width x rows values, `counts` width x rows, `sum_sq` 3 x width x rows or
+// empty. Returns false (leaving the rest added) where a sum or count overflowed.
+bool add_rows_into(Film& into, uint32_t first_row, uint32_t rows, const int64_t* sums, const uint32_t* counts,
+                   const double* sum_sq);
 
 }  // namespace pb::run

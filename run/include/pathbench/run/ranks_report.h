@@ -23,7 +23,7 @@
 namespace pb::run {
 
 nlohmann::json rank_entry(int rank, const std::string& host, const RenderSettings& s, const RunReport& r,
-                          int gpu_index, uint32_t samples_per_pixel, int chunks, double wall_seconds);
+                          int gpu_index, uint64_t samples, int chunks, double wall_seconds);  // samples: (pixel, sample) pairs
 
 // Sums rays, paths and discarded samples of `ranks` (rank_entry dumps, in rank order) into
 // `report` (rank 0's own), sets its times to the frame's, and adds extra["ranks"].

@@ -64,6 +64,11 @@ class World {
   // overflow refused with std::overflow_error on rank 0). Other ranks' films are left as
   // they were. The variance sums (doubles) are summed in MPI's order, not bit for bit.
   void reduce_film(Film& film);
+  // Collective: the same for dynamic chunks, where each rank traced bands of rows (`mine`,
+  // merged): every other rank sends rank 0 its rows alone, which rank 0 adds (checked; an
+  // overflow throws std::overflow_error on rank 0 after every rank's rows arrived).
+  // Sums and counts are exact, so the film equals reduce_film's.
+  void reduce_film_rows(Film& film, const std::vector<RowRange>& mine);
   // Whether rank 0 can serve a SampleDispenser from a thread (MPI gave at least
   // MPI_THREAD_SERIALIZED); otherwise ranks split the samples statically.
   bool can_dispense() const;
@@ -87,36 +92,36 @@ class World {
 // it to decide whether to, and `pathbench bench` (app/) for the child that joins the run.
 int launcher_rank();
 
-// Dynamic balancing: ranks take chunks of samples ([first, first + count) of every
-// pixel) from one counter held by rank 0, which answers the other ranks from a thread of
-// its own while it renders. A chunk's size follows the asking rank's measured rate (its
-// samples per pixel per second), so a GPU and a CPU rank finish together (chunk_size).
+// Dynamic balancing: ranks take chunks of the frame's units (UnitRange, ranks.h: row-major
+// rows x samples) from one counter held by rank 0, which answers the other ranks from a
+// thread of its own while it renders. A chunk's size follows the asking rank's measured
+// rate (its units per second), so a GPU and a CPU rank finish together (chunk_size).
 // Every rank constructs it and calls finish(); next() and abort() are per rank.
 class SampleDispenser {
  public:
-  SampleDispenser(World& world, uint32_t spp);
+  // `units`: the frame's (rows x spp); `probe`: a rank's first chunk, before its rate is known.
+  SampleDispenser(World& world, uint64_t units, uint64_t probe);
   ~SampleDispenser();
   SampleDispenser(const SampleDispenser&) = delete;
   SampleDispenser& operator=(const SampleDispenser&) = delete;
   // The next chunk for this rank; count 0 when the frame is handed out (or aborted).
-  // `rate`: this rank's samples per pixel per second so far (0: not measured yet).
-  SampleShare next(double rate);
+  // `rate`: this rank's units per second so far (0: not measured yet).
+  UnitRange next(double rate);
   // This rank failed: hand out nothing more, so every rank reaches the next agreement
   // within one chunk.
   void abort();
   // Collective (rank 0 waits for every rank's last request).
   void finish();
   uint64_t chunks_granted() const;  // rank 0: chunks handed out in all
-
   struct Impl;
 
  private:
   std::unique_ptr<Impl> impl_;
 };
 
-// The grant rule alone (tested in every build): `remaining` of `spp` samples per pixel
-// left, a rank of rate `rate` among ranks of total rate `total_rate` (rates of ranks
-// not measured yet counted as the mean of the measured ones by the caller).
-uint32_t chunk_size(uint32_t remaining, uint32_t spp, int ranks, double rate, double total_rate);
+// The grant rule alone (tested in every build): `remaining` units left, a rank of rate
+// `rate` among ranks of total rate `total_rate` (rates of ranks not measured yet counted
+// as the mean of the measured ones by the caller); `probe` units while its rate is unknown.
+uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double total_rate);
 
 }  // namespace pb::run
