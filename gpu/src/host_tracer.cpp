@@ -18,24 +18,23 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   const SceneView view = scene_.view();
   const BvhView bvh = bvh_.view();
   const PathConfig c = settings.path_config();
-  const uint32_t width = settings.width, spp = settings.traced_spp();
-  const uint32_t y0 = settings.first_row, y1 = y0 + settings.traced_rows();  // a rank's band, or the frame
+  const uint32_t spp = settings.traced_spp();
+  // The band of rows traced (a rank's chunk, or the frame), split by pixels: a chunk of a
+  // few rows must still keep every thread busy.
+  const uint32_t p0 = c.first_pixel, p1 = p0 + settings.traced_pixels();
   std::atomic<uint64_t> bounce{0}, shadow{0}, discarded{0};
   // The GPU's choice of kernel (pixel.cu's run_pixel): double precision and the
   // Moeller-Trumbore test switch on the layout at run time, as there; the same code.
-  auto trace_rows = [&](auto kinds, auto real, auto watertight) {
+  auto trace_pixels = [&](auto kinds, auto real, auto watertight) {
     constexpr uint32_t K = decltype(kinds)::value;
     using T = typename decltype(real)::type;
     constexpr bool W = decltype(watertight)::value;
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(y0, y1), [&](const tbb::blocked_range<uint32_t>& rows) {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(p0, p1, 16), [&](const tbb::blocked_range<uint32_t>& pixels) {
       uint32_t n_bounce = 0, n_shadow = 0, n_discarded = 0;
-      for (uint32_t y = rows.begin(); y < rows.end(); ++y)
-        for (uint32_t x = 0; x < width; ++x) {
-          const uint32_t pixel = y * width + x;
-          for (uint32_t k = 0; k < spp; ++k) {
-            const Vec3f L = trace_path_bvh<K, T, W, kAnyKind>(view, bvh, c, pixel, c.first_sample + k, n_bounce, n_shadow);
-            if (!film.add(pixel, L)) ++n_discarded;  // one writer per pixel: rows are split
-          }
+      for (uint32_t pixel = pixels.begin(); pixel < pixels.end(); ++pixel)
+        for (uint32_t k = 0; k < spp; ++k) {
+          const Vec3f L = trace_path_bvh<K, T, W, kAnyKind>(view, bvh, c, pixel, c.first_sample + k, n_bounce, n_shadow);
+          if (!film.add(pixel, L)) ++n_discarded;  // one writer per pixel: pixels are split
         }
       bounce += n_bounce;
       shadow += n_shadow;
@@ -46,9 +45,9 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     with_features(view.material_kinds, [&](auto kinds) {
-      if (settings.precision == Precision::Double) trace_rows(kinds, std::type_identity<double>{}, std::true_type{});
-      else if (!settings.watertight) trace_rows(kinds, std::type_identity<float>{}, std::false_type{});
-      else trace_rows(kinds, std::type_identity<float>{}, std::true_type{});
+      if (settings.precision == Precision::Double) trace_pixels(kinds, std::type_identity<double>{}, std::true_type{});
+      else if (!settings.watertight) trace_pixels(kinds, std::type_identity<float>{}, std::false_type{});
+      else trace_pixels(kinds, std::type_identity<float>{}, std::true_type{});
     });
   });
   const uint64_t paths = settings.traced_samples();
