@@ -41,6 +41,11 @@ struct DeviceFilm::Impl {
 DeviceFilm::DeviceFilm() : impl_(std::make_unique<Impl>()) {}
 DeviceFilm::~DeviceFilm() = default;
 bool DeviceFilm::used() const { return impl_->used; }
+void DeviceFilm::clear() {
+  if (!impl_->used) return;
+  impl_->fb.clear(nullptr);
+  PB_CUDA_CHECK(cudaDeviceSynchronize());
+}
 
 namespace {
 // Film back to the host: the device's unsigned sums are Film's int64 sums mod 2^64.

@@ -18,9 +18,9 @@ constexpr int kAsk = 1, kGrant = 2, kQuit = 3;
 }
 
 struct SampleDispenser::Impl {
-  Impl(World& w, uint64_t u, uint64_t p) : world(w), units(u), probe(p) {}
+  Impl(World& w, uint64_t u) : world(w), units(u) {}
   World& world;
-  uint64_t units, probe;
+  uint64_t units;
   MPI_Comm comm = mpi_detail::chunk_comm();
   // Rank 0's counter, guarded by `m` (its own render and the server thread take from it).
   std::mutex m;
@@ -31,7 +31,7 @@ struct SampleDispenser::Impl {
   std::thread server;
   bool done = false;  // this rank has had its last grant (or quit)
 
-  UnitRange grant(int rank, double rate) {
+  UnitRange grant(int rank, double rate, uint64_t probe) {
     std::lock_guard<std::mutex> lock(m);
     if (rate > 0) rates[size_t(rank)] = rate;
     if (aborted) return {next, 0};
@@ -61,9 +61,9 @@ struct SampleDispenser::Impl {
         continue;
       }
       if (st.MPI_TAG == kAsk) {
-        double rate = 0;
-        MPI_Recv(&rate, 1, MPI_DOUBLE, st.MPI_SOURCE, kAsk, comm, MPI_STATUS_IGNORE);
-        const UnitRange s = grant(st.MPI_SOURCE, rate);
+        double ask[2] = {0, 0};  // rate, probe
+        MPI_Recv(ask, 2, MPI_DOUBLE, st.MPI_SOURCE, kAsk, comm, MPI_STATUS_IGNORE);
+        const UnitRange s = grant(st.MPI_SOURCE, ask[0], uint64_t(ask[1]));
         const uint64_t g[2] = {s.first, s.count};
         MPI_Send(g, 2, MPI_UINT64_T, st.MPI_SOURCE, kGrant, comm);
         if (s.count == 0) ++finished;
@@ -77,8 +77,7 @@ struct SampleDispenser::Impl {
   }
 };
 
-SampleDispenser::SampleDispenser(World& world, uint64_t units, uint64_t probe)
-    : impl_(std::make_unique<Impl>(world, units, probe)) {
+SampleDispenser::SampleDispenser(World& world, uint64_t units) : impl_(std::make_unique<Impl>(world, units)) {
   impl_->rates.assign(size_t(world.size()), 0.0);
   if (world.root() && world.size() > 1) impl_->server = std::thread([this] { impl_->serve(); });
 }
@@ -87,15 +86,16 @@ SampleDispenser::~SampleDispenser() {
   if (impl_->server.joinable()) impl_->server.join();
 }
 
-UnitRange SampleDispenser::next(double rate) {
+UnitRange SampleDispenser::next(double rate, uint64_t probe) {
   Impl& d = *impl_;
   if (d.done) return {0, 0};
   UnitRange s;
   if (d.world.root()) {
-    s = d.grant(0, rate);
+    s = d.grant(0, rate, probe);
   } else {
     uint64_t g[2] = {0, 0};
-    MPI_Send(&rate, 1, MPI_DOUBLE, 0, kAsk, d.comm);
+    const double ask[2] = {rate, double(probe)};
+    MPI_Send(ask, 2, MPI_DOUBLE, 0, kAsk, d.comm);
     MPI_Recv(g, 2, MPI_UINT64_T, 0, kGrant, d.comm, MPI_STATUS_IGNORE);
     s = {g[0], g[1]};
   }

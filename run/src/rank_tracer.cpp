@@ -93,6 +93,22 @@ void RankTracer::trace(const FrameBlock& block, Film& film, RunReport& report) {
   report.tracer_host_bytes = std::max(report.tracer_host_bytes, chunk.tracer_host_bytes);
 }
 
+void RankTracer::warm_up(Film& film) {
+#if PATHBENCH_HAVE_CUDA
+  if (!gpu_) return;
+  // One sample of the first row into the device film (kernels loaded, the film allocated
+  // and touched), then cleared: `film` itself is not written.
+  RenderSettings w = settings_;
+  w.row_count = w.sample_count = 1;
+  w.progress = false;
+  RunReport ignored;
+  gpu::render(scene_, gpu_->scene, w, film, ignored, false, &gpu_->film);
+  gpu_->film.clear();
+#else
+  (void)film;
+#endif
+}
+
 void RankTracer::finish(Film& film, RunReport& report) {
 #if PATHBENCH_HAVE_CUDA
   if (gpu_ && gpu_->film.used()) report.extra["film_download_seconds"] = gpu_->film.download(film);

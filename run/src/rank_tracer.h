@@ -27,6 +27,9 @@ class RankTracer {
   // discarded samples and times into `report`. A GPU rank's blocks add up on the device
   // until finish().
   void trace(const FrameBlock& block, Film& film, RunReport& report);
+  // Before the frame's clock starts (film sized and begun): a GPU rank's warm-up, as one
+  // GPU process warms up before its timed frame. Nothing on the CPU.
+  void warm_up(Film& film);
   // After the rank's last block: a GPU rank's film comes back from the device (once).
   void finish(Film& film, RunReport& report);
 

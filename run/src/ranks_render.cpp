@@ -146,6 +146,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
       film = Film(s.width, s.height, variance);
     film.begin(s.spp, scene.max_emission());  // the frame's scale on every rank
+    tracer->warm_up(film);
   });
   Balance balance = options.balance;
   if (balance == Balance::Auto)
@@ -169,22 +170,25 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     add_rows(rows, b);
   };
   {
-    // Dynamic balancing only: rank 0 then serves it. Its units are rows x samples, and a
-    // rank's first chunk (its probe) one unit a row: a sample per pixel's worth.
+    // Dynamic balancing only: rank 0 then serves it (its units: rows x samples).
     std::optional<SampleDispenser> dispenser;
-    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, uint64_t(s.height));
+    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp);
     try {
       if (balance == Balance::Static) {
         const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
         if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
-        uint64_t units = 0;
+        // A rank's first chunk measures its rate: ~2 M samples fill a GPU (an H100 runs
+        // ~270 k threads at once), a few hundred per thread keep a CPU rank's probe short.
+        const uint64_t probe_samples = s.device == Device::Gpu ? uint64_t(1) << 21 : uint64_t(s.threads) * 256;
+        const uint64_t probe = std::max<uint64_t>(1, (probe_samples + s.width - 1) / s.width);
+        double rate = 0;  // units per second in the last chunk
         for (;;) {
-          const double rate = mine.seconds > 0 ? double(units) / mine.seconds : 0.0;
-          const UnitRange range = dispenser->next(rate);
+          const UnitRange range = dispenser->next(rate, probe);
           if (range.count == 0) break;
+          const double before = mine.seconds;
           for (const FrameBlock& b : blocks_of(range, s.spp, s.height)) trace(b);
-          units += range.count;
+          if (mine.seconds > before) rate = double(range.count) / (mine.seconds - before);
           ++chunks;
         }
       }

@@ -170,11 +170,11 @@ TEST(RankSplit, OneProcessIsOneRank) {
   EXPECT_EQ(w.size(), 1);
   EXPECT_TRUE(w.root());
   // Whole-frame dispensing in one rank: everything, then nothing.
-  run::SampleDispenser d(w, 9, 2);
-  const run::UnitRange a = d.next(0);
+  run::SampleDispenser d(w, 9);
+  const run::UnitRange a = d.next(0, 2);
   EXPECT_EQ(a.first, 0u);
   EXPECT_EQ(a.count, 9u);
-  EXPECT_EQ(d.next(1.0).count, 0u);
+  EXPECT_EQ(d.next(1.0, 2).count, 0u);
   d.finish();
   EXPECT_THROW(run::rank_device("hybrid"), InputError);
   EXPECT_EQ(run::rank_device("cpu"), "cpu");

@@ -71,6 +71,9 @@ class DeviceFilm {
   DeviceFilm& operator=(const DeviceFilm&) = delete;
   // Whether a render has added into it yet.
   bool used() const;
+  // Zeroes its sums and counts, keeping the buffers (and the warm-up done): a rank warms
+  // its GPU up with a render into it before the frame's clock starts, then clears it.
+  void clear();
   // Replaces `film`'s sums and counts (and variance sums) with the device's: the sums of
   // every render into it. Returns the seconds the copy took.
   double download(Film& film) const;

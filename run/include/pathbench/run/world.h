@@ -99,14 +99,16 @@ int launcher_rank();
 // Every rank constructs it and calls finish(); next() and abort() are per rank.
 class SampleDispenser {
  public:
-  // `units`: the frame's (rows x spp); `probe`: a rank's first chunk, before its rate is known.
-  SampleDispenser(World& world, uint64_t units, uint64_t probe);
+  // `units`: the frame's (rows x spp).
+  SampleDispenser(World& world, uint64_t units);
   ~SampleDispenser();
   SampleDispenser(const SampleDispenser&) = delete;
   SampleDispenser& operator=(const SampleDispenser&) = delete;
   // The next chunk for this rank; count 0 when the frame is handed out (or aborted).
-  // `rate`: this rank's units per second so far (0: not measured yet).
-  UnitRange next(double rate);
+  // `rate`: this rank's units per second in its last chunk (0: not measured yet);
+  // `probe`: the chunk it wants while its rate is unknown (a GPU needs a larger one than
+  // a CPU to measure a rate that holds: a small chunk leaves most of a GPU idle).
+  UnitRange next(double rate, uint64_t probe);
   // This rank failed: hand out nothing more, so every rank reaches the next agreement
   // within one chunk.
   void abort();
