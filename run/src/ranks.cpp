@@ -91,17 +91,19 @@ void reduce_film(Film& into, const Film& part) {
 
 uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double total_rate) {
   if (remaining == 0) return 0;
-  // Not measured yet: a probe (one sample per pixel's worth of units: a CPU rank's first
-  // chunk must not outlast a GPU's whole frame). Then a fraction f of what is left, shared
+  // Not measured yet: the rank's probe (small enough that a CPU rank's first chunk does
+  // not outlast a GPU's whole frame, large enough to measure a GPU's rate). Then a fraction f of what is left, shared
   // by rate: every rank's chunk ends after about f of the frame's remaining time, whoever
   // it is, so ranks finish close together. f grows from 3/4 with the rank's share of the
   // rate, so that a dominant rank (a GPU beside CPUs, whose every call costs kernel
   // launches and a partly idle device at its end) needs few chunks, and slow ranks take
   // the smaller ones at the end.
+  // Never less than the probe: below it a GPU's call costs more than its samples (a
+  // partly idle device, a launch, a sync), so the last crumbs go in one chunk.
   const double share = rate > 0 && total_rate > 0 ? std::min(1.0, rate / total_rate) : 0.0;
-  const double want = share > 0 ? std::ceil((0.75 + 0.2 * share) * share * double(remaining))
-                                : double(std::max<uint64_t>(probe, 1));
-  return uint64_t(std::min<double>(std::max(want, 1.0), double(remaining)));
+  const double least = double(std::max<uint64_t>(probe, 1));
+  const double want = share > 0 ? std::max(std::ceil((0.75 + 0.2 * share) * share * double(remaining)), least) : least;
+  return uint64_t(std::min<double>(want, double(remaining)));
 }
 
 }  // namespace pb::run

@@ -141,9 +141,10 @@ TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
   EXPECT_EQ(run::chunk_size(5, 12, 0, 0), 5u);
   // A rank with 3/4 of the total rate gets (3/4 + 0.2 x 3/4) x 3/4 of what is left.
   EXPECT_EQ(run::chunk_size(800, 12, 3.0, 4.0), 540u);
-  // Never more than is left, never less than one.
+  // Never more than is left, never less than the probe.
   EXPECT_EQ(run::chunk_size(5, 12, 100.0, 100.0), 5u);
-  EXPECT_EQ(run::chunk_size(500, 12, 1.0, 1000.0), 1u);
+  EXPECT_EQ(run::chunk_size(500, 12, 1.0, 1000.0), 12u);
+  EXPECT_EQ(run::chunk_size(500, 0, 1.0, 1000.0), 1u);
   EXPECT_EQ(run::chunk_size(0, 12, 1.0, 1.0), 0u);
   // Beyond 32 bits (a 65536-row frame at 2^17 spp).
   EXPECT_EQ(run::chunk_size(uint64_t(1) << 33, 12, 1.0, 1.0), uint64_t(0.95 * double(uint64_t(1) << 33)) + 1);

@@ -106,8 +106,8 @@ class SampleDispenser {
   SampleDispenser& operator=(const SampleDispenser&) = delete;
   // The next chunk for this rank; count 0 when the frame is handed out (or aborted).
   // `rate`: this rank's units per second in its last chunk (0: not measured yet);
-  // `probe`: the chunk it wants while its rate is unknown (a GPU needs a larger one than
-  // a CPU to measure a rate that holds: a small chunk leaves most of a GPU idle).
+  // `probe`: the chunk it wants while its rate is unknown, and its smallest chunk (a GPU
+  // needs a larger one than a CPU: a small chunk leaves most of a GPU idle).
   UnitRange next(double rate, uint64_t probe);
   // This rank failed: hand out nothing more, so every rank reaches the next agreement
   // within one chunk.
@@ -123,7 +123,8 @@ class SampleDispenser {
 
 // The grant rule alone (tested in every build): `remaining` units left, a rank of rate
 // `rate` among ranks of total rate `total_rate` (rates of ranks not measured yet counted
-// as the mean of the measured ones by the caller); `probe` units while its rate is unknown.
+// as the mean of the measured ones by the caller); `probe` units while its rate is
+// unknown, and never less than that (the last crumbs go to whoever asks first).
 uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double total_rate);
 
 }  // namespace pb::run
