@@ -39,7 +39,12 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
 }
 
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind>
-__global__ void __launch_bounds__(256) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
+// Blocks an SM must fit (registers capped to match); 1 = the compiler's choice (80
+// registers: 3 blocks of 256). PB_PIXEL_MIN_BLOCKS overrides it for experiments.
+#ifndef PB_PIXEL_MIN_BLOCKS
+#define PB_PIXEL_MIN_BLOCKS 1
+#endif
+__global__ void __launch_bounds__(256, PB_PIXEL_MIN_BLOCKS) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
   kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
