@@ -3,12 +3,17 @@
 // registers. Samples of one pixel are summed in the warp (exact integer sums) before one
 // atomic per pixel.
 #include <cuda_runtime.h>
+#include <fmt/core.h>
+
+#include <cstdlib>
+#include <string>
 
 #include "device_film.cuh"
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
 #include "pathbench/gpu/traversal.h"
+#include "pathbench/common/errors.h"
 #include "strategies.cuh"
 
 namespace pb::gpu {
@@ -38,13 +43,12 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
   }
 }
 
-template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind>
-// Blocks an SM must fit (registers capped to match); 1 = the compiler's choice (80
-// registers: 3 blocks of 256). PB_PIXEL_MIN_BLOCKS overrides it for experiments.
-#ifndef PB_PIXEL_MIN_BLOCKS
-#define PB_PIXEL_MIN_BLOCKS 1
-#endif
-__global__ void __launch_bounds__(256, PB_PIXEL_MIN_BLOCKS) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
+// kMinBlocks: blocks of 256 an SM must fit, registers capped to match (1: the compiler's
+// choice, 91 registers and 2 blocks for the float watertight kernel). Measured on an H100
+// (gpu/NOTES.md, "Occupancy of the megakernel"): 3 blocks suit scenes whose BVH sits in
+// L1 (issue bound), 5 (48 registers, spills) scenes that miss to L2 (latency bound).
+template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks>
+__global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
   kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
@@ -67,23 +71,37 @@ __global__ void __launch_bounds__(256, PB_PIXEL_MIN_BLOCKS) k_pixel(SceneView s,
 
 }  // namespace
 
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
+  const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  const std::string v = env ? env : "auto";
+  if (v == "3") return {3, "PATHBENCH_GPU_PIXEL_BLOCKS=3"};
+  if (v == "5") return {5, "PATHBENCH_GPU_PIXEL_BLOCKS=5"};
+  if (v != "auto")
+    throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or 5", v));
+  if (g.bvh_tris >= kPixelLatencyBoundTris)
+    return {5, fmt::format("auto: {} triangles >= {} (latency bound: more warps)", g.bvh_tris, kPixelLatencyBoundTris)};
+  return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
+}
+
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<Stats>& stats) {
+                      DeviceBuffer<Stats>& stats, int min_blocks) {
   PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
-  // In float with the watertight test, compiled for the scene's BVH layout; or (the
-  // accuracy study's variants) in double or with Moeller-Trumbore, switching on it.
+  // In float with the watertight test, compiled for the scene's BVH layout and the
+  // occupancy that suits its size; or (the accuracy study's variants) in double or with
+  // Moeller-Trumbore, switching on it at the compiler's occupancy.
   with_features(g.view.material_kinds, [&](auto kinds) {
     constexpr uint32_t K = decltype(kinds)::value;
     auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, stats.get()); };
     constexpr int kAny = kAnyKind;
-    if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny>) : go(k_pixel<false, K, double, true, kAny>);
-    else if (!watertight) variance ? go(k_pixel<true, K, float, false, kAny>) : go(k_pixel<false, K, float, false, kAny>);
+    if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny, 1>) : go(k_pixel<false, K, double, true, kAny, 1>);
+    else if (!watertight) variance ? go(k_pixel<true, K, float, false, kAny, 1>) : go(k_pixel<false, K, float, false, kAny, 1>);
     else
       with_traversal_kind(g.bvh.kind, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
-        variance ? go(k_pixel<true, K, float, true, B>) : go(k_pixel<false, K, float, true, B>);
+        if (min_blocks == 5) variance ? go(k_pixel<true, K, float, true, B, 5>) : go(k_pixel<false, K, float, true, B, 5>);
+        else variance ? go(k_pixel<true, K, float, true, B, 3>) : go(k_pixel<false, K, float, true, B, 3>);
       });
   });
   FrameResult r;

@@ -149,10 +149,11 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
   }
 
+  const PixelOccupancy occupancy = settings.strategy == Strategy::Pixel ? pixel_occupancy(g) : PixelOccupancy{};
   auto run_frame = [&](uint64_t n) {
     if (settings.strategy == Strategy::Pixel)
       return run_pixel(launch, stream.s, g, config, spp, n, fb.view, film.has_variance(), settings.precision,
-                       settings.watertight, pixel_stats);
+                       settings.watertight, pixel_stats, occupancy.min_blocks);
     return pool->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
   };
 
@@ -237,7 +238,11 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     x["bytes_per_task"] = r.state_bytes_per_path;  // the queues are the compacted state buffers themselves
     x["tasks"] = total;
   }
-  if (settings.strategy == Strategy::Pixel) x["pixel_block"] = launch.block_size("pixel");
+  if (settings.strategy == Strategy::Pixel) {
+    x["pixel_block"] = launch.block_size("pixel");
+    if (settings.precision == Precision::Float && settings.watertight)
+      x["pixel_occupancy"] = {{"min_blocks_per_sm", occupancy.min_blocks}, {"why", occupancy.why}};
+  }
   if (profile) {
     const nlohmann::json prof = launch.collect();
     x["profile"] = prof;

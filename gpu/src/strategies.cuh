@@ -5,6 +5,7 @@
 #include <cuda_runtime.h>
 
 #include <cstdint>
+#include <string>
 
 #include "cuda_util.h"
 #include "device_film.cuh"
@@ -34,10 +35,22 @@ struct ShadowUse {
   }
 };
 
+// The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
+// and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
+// and the megakernel waits on memory (more warps hide it); below, it is issue bound.
+// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|5 overrides it (a bad value: InputError).
+struct PixelOccupancy {
+  int min_blocks = 3;
+  std::string why;
+};
+constexpr uint32_t kPixelLatencyBoundTris = 65536;
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
+
 // The pixel megakernel over `total` samples (spp per pixel), compiled for the scene's
-// material kinds; `stats` is its counter block on the device.
+// material kinds; `stats` is its counter block on the device; `min_blocks` from
+// pixel_occupancy (float and watertight only: the accuracy variants keep the compiler's).
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<Stats>& stats);
+                      DeviceBuffer<Stats>& stats, int min_blocks);
 
 }  // namespace pb::gpu
