@@ -43,7 +43,7 @@ struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
 };
-constexpr uint32_t kPixelLatencyBoundTris = 65536;
+constexpr uint32_t kPixelLatencyBoundTris = 16384;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
 // The pixel megakernel over `total` samples (spp per pixel), compiled for the scene's
