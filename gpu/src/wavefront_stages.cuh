@@ -96,11 +96,8 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
   sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
 }
 
-#ifndef PB_WF_SHADE_MIN_BLOCKS
-#define PB_WF_SHADE_MIN_BLOCKS 3  // blocks of 256 an SM for shade (80 registers); overridable for experiments
-#endif
 template <bool kVariance, uint32_t Kinds>
-__global__ void __launch_bounds__(256, PB_WF_SHADE_MIN_BLOCKS) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
+__global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film,
                                                      uint32_t spp) {
   kernel_prologue();
