@@ -24,8 +24,10 @@
 
 namespace pb::cpu::PB_SIMD_NS {
 
-// path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), *shadow[i], wants_shadow[i])
-// for every lane i < kLanes; `table` is built from `s`.
+// path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), q, wants_shadow)
+// for every lane i < b.lanes; `table` is built from `s`. What path_hit returns goes to
+// the batch's streams (ShadeBatch): the shadow query's ray and contribution where
+// wants_shadow, the next ray where the path goes on, packed per kind (Packer).
 [[gnu::flatten]] inline void shade_diffuse(const SceneView& s, const PathConfig& c, const ShadeTable& table, ShadeBatch& b) {
   constexpr int N = kLanes;
   const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
@@ -107,7 +109,7 @@ namespace pb::cpu::PB_SIMD_NS {
 
   // 3. Light sampling.
   IV shadow = IV{};
-  V3 contribution, shadow_d;
+  V3 contribution{}, shadow_d{};
   if (nee) {
     const FV su = sqrt(u_pick);
     const FV tb1 = 1.0f - su, tb2 = u3 * su;
@@ -169,14 +171,35 @@ namespace pb::cpu::PB_SIMD_NS {
   for (int i = 0; i < N; ++i) out_rows[i] = b.st[i];
   store_rows(ra, out_rows, 0, b.lanes);
   store_rows(rb, out_rows, 8, b.lanes);
-  for (int i = 0; i < b.lanes; ++i) {
-    b.wants_shadow[i] = shadow[i] != 0;
-    b.cont[i] = cont[i] != 0;
-    if (shadow[i]) {
-      ShadowQuery<float>& q = *b.shadow[i];
-      q.ray = {{origin.x[i], origin.y[i], origin.z[i]}, {shadow_d.x[i], shadow_d.y[i], shadow_d.z[i]}};
-      q.contribution = {contribution.x[i], contribution.y[i], contribution.z[i]};
-    }
+
+  // The lanes to the caller's streams (ShadeBatch), each kind packed in lane order.
+  const uint32_t used = uint32_t((uint64_t(1) << b.lanes) - 1);
+  const uint32_t m_cont = lane_mask(cont) & used, m_shadow = lane_mask(shadow) & used;
+  const uint32_t m_final = m_cont & lane_mask(UV(vertex) >= (UV{} + b.final_depth));
+  b.done = used & ~m_cont & ~m_shadow;
+  UV tag;
+  std::memcpy(&tag, b.tag, sizeof tag);
+  if (ShadeStream* out = b.next) {
+    const Packer pk(m_cont & ~m_final);
+    const FV r[6] = {origin.x, origin.y, origin.z, wi_next.x, wi_next.y, wi_next.z};
+    for (int j = 0; j < 6; ++j) pk.store(out->ray[j] + out->n, r[j]);
+    pk.store(out->tag + out->n, tag);
+    out->n += uint32_t(pk.count);
+  }
+  if (ShadeStream* out = b.final; out && m_final) {
+    const Packer pk(m_final);
+    pk.store(out->tag + out->n, tag);
+    out->n += uint32_t(pk.count);
+  }
+  if (ShadeStream* out = b.shadow; out && m_shadow) {  // (m_shadow is 0 without nee)
+    const Packer pk(m_shadow);
+    const FV r[6] = {origin.x, origin.y, origin.z, shadow_d.x, shadow_d.y, shadow_d.z};
+    for (int j = 0; j < 6; ++j) pk.store(out->ray[j] + out->n, r[j]);
+    pk.store(out->contribution[0] + out->n, contribution.x);
+    pk.store(out->contribution[1] + out->n, contribution.y);
+    pk.store(out->contribution[2] + out->n, contribution.z);
+    pk.store(out->tag + out->n, tag | UV(cont ? IV{} : splat_i(int32_t(ShadeStream::kEnds))));
+    out->n += uint32_t(pk.count);
   }
 }
 
@@ -244,7 +267,7 @@ namespace pb::cpu::PB_SIMD_NS {
 // path_begin (path.h) for kLanes new paths: camera_ray (camera.h) lane-wise in its order
 // of operations, the camera's random numbers from rng_draw.
 inline void begin_paths(const SceneView& s, const PathConfig& c, const uint32_t* pixel, const uint32_t* sample,
-                        PathState<float>* const* st, int lanes) {
+                        PathState<float>* const* st, int lanes, float* const* rays) {
   constexpr int N = kLanes;
   UV pix, smp;
   IV px, py;
@@ -274,21 +297,8 @@ inline void begin_paths(const SceneView& s, const PathConfig& c, const uint32_t*
   for (int i = 0; i < N; ++i) out_rows[i] = st[i];
   store_rows(ra, out_rows, 0, lanes);
   store_rows(rb, out_rows, 8, lanes);
-}
-
-}  // namespace pb::cpu::PB_SIMD_NS
-
-namespace pb::cpu::PB_SIMD_NS {
-
-// A ray (the first six floats of each of kLanes records: PathState::ray, ShadowQuery::ray)
-// into the arrays of an Embree packet of kLanes rays (out: org_x, org_y, org_z, dir_x,
-// dir_y, dir_z): what set_lane (embree_rays.h) does for floats.
-inline void rays_to_packet(const void* const* rows, float* const* out) {
-  FV r[8];
-  load_rows(rows, 0, r);
-  // Unrolled: as a loop g++ stores each register through the stack in 16-byte halves.
-#pragma GCC unroll 6
-  for (int j = 0; j < 6; ++j) std::memcpy(out[j], &r[j], sizeof r[j]);
+  if (rays)
+    for (int j = 0; j < 6; ++j) store_first(rays[j], ra[j], lanes);
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS
