@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "embree_rays.h"
+#include "film_combiner.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
@@ -65,7 +66,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
  public:
   Slice(const TraceJob& job, const BatchKernels* k, const ShadeTable* table, const TinyScene* tiny, SampleSource& src,
         size_t paths, Local& local)
-      : job_(job), k_(k), table_(table), tiny_(tiny), src_(src), pool_(paths, k != nullptr), local_(local) {
+      : job_(job), k_(k), table_(table), tiny_(tiny), src_(src), pool_(paths, k != nullptr), local_(local), film_(job.film) {
     rtcInitIntersectContext(&ctx_);
     // path_at_final_vertex as one compare of the depth.
     if (job.config.max_bounces >= 0 && job.scene.num_emitters <= kMaxEmittersForFinalQuery)
@@ -87,6 +88,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
       local_.paths += finished_;
       job_.progress.advance(finished_);
     }
+    film_.flush();
     // Every closest-hit query of a depth-0 path is its camera ray (count_ray).
     local_.rays.camera += camera_;
     local_.rays.bounce += closest_ - camera_;
@@ -103,14 +105,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
     std::vector<uint32_t>& to = at_final ? pool_.final : pool_.live;
     uint32_t& count = at_final ? pool_.n_final : pool_.n_live;
     if (!at_final) camera_ += n;
-    uint32_t pixel = src_.pixel_of(start), sample = src_.sample_of(start);
-    const uint32_t pixels = src_.pixels();
-    auto next = [&] {  // (pixel, sample) of the next global index, without a division
-      if (++pixel == pixels) {
-        pixel = 0;
-        ++sample;
-      }
-    };
+    SampleSource::Cursor at = src_.at(start);
     uint32_t* free = pool_.free.data();
     uint32_t n_free = pool_.n_free, out = count;
     if constexpr (std::is_same_v<T, float>) {
@@ -124,9 +119,9 @@ template <class T, uint32_t Kinds, int W> class Slice {
           uint32_t px[kMaxShadeLanes], smp[kMaxShadeLanes];
           PathState<float>* st[kMaxShadeLanes];
           for (int l = 0; l < lanes; ++l) {
-            px[l] = pixel;
-            smp[l] = sample;
-            next();
+            px[l] = at.pixel;
+            smp[l] = at.sample;
+            src_.step(at);
             const uint32_t slot = free[--n_free];
             st[l] = &pool_.state[slot];
             to[out++] = slot;
@@ -143,9 +138,9 @@ template <class T, uint32_t Kinds, int W> class Slice {
         return;
       }
     }
-    for (uint64_t i = 0; i < n; ++i, next()) {
+    for (uint64_t i = 0; i < n; ++i, src_.step(at)) {
       const uint32_t slot = free[--n_free];
-      path_begin(job_.scene, job_.config, pixel, sample, pool_.state[slot]);
+      path_begin(job_.scene, job_.config, at.pixel, at.sample, pool_.state[slot]);
       to[out++] = slot;
     }
     pool_.n_free = n_free;
@@ -361,7 +356,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
 
   // A path is done: its radiance to the film, its slot free.
   void finish(uint32_t slot) {
-    if (!job_.film.add_atomic(pool_.state[slot].pixel, Vec3f(pool_.state[slot].L))) ++local_.discarded;
+    if (!film_.add(pool_.state[slot].pixel, Vec3f(pool_.state[slot].L))) ++local_.discarded;
     pool_.free[pool_.n_free++] = slot;
     ++finished_;
   }
@@ -373,6 +368,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
   SampleSource& src_;
   PoolSlice<T> pool_;
   Local& local_;
+  FilmCombiner film_;
   RTCIntersectContext ctx_;
   uint32_t final_depth_ = std::numeric_limits<uint32_t>::max();  // never, without the final query
   alignas(64) RTCRayHitNt<W> hit_packet_;
@@ -389,7 +385,7 @@ template <class T, uint32_t Kinds, int W>
 TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
                       std::unique_ptr<ShadeTable> table) {
   const uint32_t pixels = job.config.width * job.config.height;
-  SampleSource source(uint64_t(pixels) * job.spp, pixels, job.config.first_sample);
+  SampleSource source(pixels, job.spp, job.config.first_sample, W);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
   // A pool that cannot fit is a setting to lower, not a std::bad_alloc (exit 2, not 1).

@@ -16,27 +16,53 @@
 namespace pb::cpu {
 namespace {
 
-// Hands out (pixel, sample) pairs in pixel-fastest order, so paths started together
-// are neighbours on the image (coherent camera rays).
+// Hands out (pixel, sample) pairs: the samples in groups of up to `group` (a packet's
+// width), each group pixel by pixel, its samples of one pixel one after the other. Paths
+// started together are then samples of one pixel and its neighbours (coherent camera
+// rays, as the pixel strategy's packets), and paths that end together add to one film
+// pixel, whose sums stay in cache (pixel-fastest order touched every film line once per
+// pass over the image: a miss, under a locked add, per path; cpu/NOTES.md). The order
+// cannot change the image: each path's numbers come from its (pixel, sample) alone, and
+// the film's sums are integers.
 class SampleSource {
  public:
-  SampleSource(uint64_t total, uint32_t pixels, uint32_t first_sample)
-      : total_(total), pixels_(pixels), first_(first_sample) {}
+  SampleSource(uint32_t pixels, uint32_t spp, uint32_t first_sample, uint32_t group)
+      : total_(uint64_t(pixels) * spp), pixels_(pixels), spp_(spp), first_(first_sample), group_(std::max(1u, group)) {}
   // Claims up to n samples; returns the first global index and sets n to the count.
   uint64_t claim(uint64_t& n) {
     uint64_t start = next_.fetch_add(n, std::memory_order_relaxed);
     n = start >= total_ ? 0 : std::min(n, total_ - start);
     return start;
   }
-  uint32_t pixel_of(uint64_t g) const { return uint32_t(g % pixels_); }
-  uint32_t sample_of(uint64_t g) const { return first_ + uint32_t(g / pixels_); }
-  uint32_t pixels() const { return pixels_; }
+  // Where global index g is, and the next one (stepping without a division).
+  struct Cursor {
+    uint32_t pixel, sample;  // sample: within [first, first + spp)
+    uint32_t in_group, group_size;
+  };
+  Cursor at(uint64_t g) const {
+    const uint64_t full = uint64_t(pixels_) * group_;  // indices in a full group
+    const uint64_t k = std::min<uint64_t>(g / full, spp_ / group_);
+    const uint32_t size = std::min(group_, spp_ - uint32_t(k) * group_);
+    const uint64_t r = g - k * full;
+    return {uint32_t(r / size), first_ + uint32_t(k) * group_ + uint32_t(r % size), uint32_t(r % size), size};
+  }
+  void step(Cursor& c) const {
+    ++c.sample;
+    if (++c.in_group < c.group_size) return;
+    c.in_group = 0;
+    c.sample -= c.group_size;
+    if (++c.pixel < pixels_) return;
+    c.pixel = 0;  // the next group of samples
+    c.sample += c.group_size;
+    c.group_size = std::min(group_, first_ + spp_ - c.sample);
+  }
 
  private:
   std::atomic<uint64_t> next_{0};
   uint64_t total_;
-  uint32_t pixels_;
-  uint32_t first_;  // samples [first_, first_ + total_ / pixels_) of each pixel
+  uint32_t pixels_, spp_;
+  uint32_t first_;  // samples [first_, first_ + spp_) of each pixel
+  uint32_t group_;
 };
 
 // One thread's share of the paths in flight. Every slot is in exactly one place at a
@@ -93,13 +119,20 @@ template <class T, int W> struct PendingShadows {
     s.n = n;
     return s;
   }
-  // The first `used` entries were traced: the rest to the front.
+  // The first `used` entries were traced: the rest (fewer than W) to the front, copied
+  // as W entries of constant size (a few vector moves; a memmove of `rest` entries is a
+  // library call per array).
   void drop(uint32_t used) {
     const uint32_t rest = n - used;
     if (rest > 0) {
-      for (auto& r : ray) std::memmove(r, r + used, rest * sizeof(float));
-      for (auto& c : contribution) std::memmove(c, c + used, rest * sizeof(T));
-      std::memmove(tag, tag + used, rest * sizeof(uint32_t));
+      auto move = [&](auto* a) {
+        std::remove_reference_t<decltype(*a)> tmp[W];
+        std::memcpy(tmp, a + used, sizeof tmp);
+        std::memcpy(a, tmp, sizeof tmp);
+      };
+      for (auto& r : ray) move(r);
+      for (auto& c : contribution) move(c);
+      move(tag);
     }
     n = rest;
   }
