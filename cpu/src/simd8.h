@@ -47,6 +47,7 @@ inline IV bits(FV v) { return (IV)v; }  // a cast between vector types of one si
 inline FV from_bits(IV v) { return (FV)v; }
 // m ? a : b per lane (m from a comparison).
 inline FV select(IV m, FV a, FV b) { return m ? a : b; }
+inline IV select_i(IV m, IV a, IV b) { return m ? a : b; }
 inline V3 select(IV m, V3 a, V3 b) { return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z}; }
 // pmin / pmax of math.h, lane-wise: the same comparison picks the same operand (NaN too).
 inline FV vmin(FV a, FV b) { return a < b ? a : b; }
