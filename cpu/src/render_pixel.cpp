@@ -75,44 +75,6 @@ template <int W> struct PixelPackets {
   }
 };
 
-// The closest hits of the rays in packet p (lanes [0, n), n <= W, written there by the
-// kernels: begin_paths, the shading's `next` stream); with `tiny`, the tiny-scene test
-// first (tiny_scene.h).
-template <int W>
-void closest_packet(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
-                    RTCRayHitNt<W>& p, int n, uint32_t* prim) {
-  // tfar, geomID: at their start values (PixelPackets)
-  if (tiny) {
-    float* rays[6];
-    packet_arrays(p.ray, rays);
-    if (tiny_closest<W>(k, *tiny, e, ctx, rays, p, n, prim) > 0) reset_packet(p);
-    return;
-  }
-  alignas(64) int valid[W];
-  for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
-  intersect_packet(valid, e.handle(), &ctx, p);
-  for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
-  reset_packet(p);
-}
-// Whether each shadow ray of packet p (lanes [0, n), written by the shading's `shadow`
-// stream) is blocked.
-template <int W>
-void occluded_packet_of(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
-                        RTCRayNt<W>& p, int n, bool* blocked) {
-  // tfar: 1 (PixelPackets)
-  if (tiny) {
-    float* rays[6];
-    packet_arrays(p, rays);
-    if (tiny_occluded<W>(k, *tiny, e, ctx, rays, p, n, blocked) > 0) reset_packet(p);
-    return;
-  }
-  alignas(64) int valid[W];
-  for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
-  occluded_packet(valid, e.handle(), &ctx, p);
-  for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
-  reset_packet(p);
-}
-
 // Diffuse-only float renders with a vector ISA (batched_shading_table): up to W = k.lanes
 // samples of one pixel at a time, each its own path, traced together: their rays as one
 // packet of W (closest hits, then shadow rays), their path steps run together W wide
@@ -168,7 +130,7 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     }
     // Closest hits (one packet); misses end their paths.
     uint32_t hit[W];
-    closest_packet<W>(job.embree, k, tiny, ctx, packets.hit, n_live, hit);
+    closest_hits<W>(k, tiny, job.embree, ctx, hit_rays, packets.hit, n_live, hit);  // tfar, geomID: PixelPackets
     (depth == 0 ? local.rays.camera : local.rays.bounce) += uint64_t(n_live);
     ShadeBatch batch;
     batch.lanes = 0;
@@ -193,7 +155,7 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
       const int n_shadowed = int(shadow.n);
       local.rays.shadow += uint64_t(n_shadowed);  // depth >= 0 here: never a camera ray
       bool blocked[W];
-      occluded_packet_of<W>(job.embree, k, tiny, ctx, packets.shadow, n_shadowed, blocked);
+      shadows_blocked<W>(k, tiny, job.embree, ctx, shadow.ray, packets.shadow, n_shadowed, blocked);  // tfar: 1
       for (int j = 0; j < n_shadowed; ++j)
         if (!blocked[j]) {
           Vec3f& L = st[shadowed[j] & ~ShadeStream::kEnds].L;  // shadow_unoccluded

@@ -8,12 +8,11 @@
 // The pass is one loop, not a stage per list: a packet's hits go straight into the
 // shading batch, shading routes each path at once (on in `live`, compacted in place; to
 // `final`; ended: to the film and `free`), so no list is rebuilt and no path is looked
-// at twice per round (cpu/NOTES.md, "Item 5, queue management", measures it). With the
-// batched path step the kernel does the routing (ShadeBatch's streams) and writes the
-// next rays where the next packet reads them (PoolSlice::ray, PendingShadows): no
-// per-lane loop, no transpose (cpu/NOTES.md, "SoA hand-over"). Per path
-// the order stays the path step's: a vertex's shadow ray is answered before the path's
-// next vertex is shaded (every pending shadow packet is traced by the end of the pass).
+// at twice per round (cpu/NOTES.md, "Item 5, queue management"). With the batched path
+// step the kernel routes, writing the next rays where the next packet reads them
+// (PoolSlice::ray, PendingShadows; cpu/NOTES.md, "SoA hand-over"). Per path the order
+// stays the path step's: a vertex's shadow ray is answered before the path's next
+// vertex is shaded (every pending shadow packet is traced by the end of the pass).
 // The film sums are integers, so the order in which paths reach it does not matter.
 // Diffuse-only float renders with a vector ISA (--isa; the paper's benchmark) run
 // generate, final vertex and shade a vector's width of paths at a time (BatchKernels,
@@ -53,10 +52,8 @@ namespace pb::cpu {
 namespace {
 
 // Packet width W: the batch's width, so one batch of rays is one packet: 16 with
-// AVX-512 (Embree's AVX-512 kernels trace 16 natively), 8 with AVX2 and for the scalar
-// path step. (Measured with callgrind on an AVX2 machine: 16-wide packets ran through
-// the same Embree kernel at the same instruction count there.)
-// (intersect_packet, occluded_packet: embree_rays.h.)
+// AVX-512, 8 with AVX2 and for the scalar path step. (closest_hits, shadows_blocked,
+// embree_closest, embree_occluded: tiny_scene.h.)
 
 // One thread's slice and the stages over it, in scalar type T, compiled for the material
 // kinds `Kinds` (features.h), with packets of W rays; `k` (width W) and `table` where the
@@ -221,24 +218,15 @@ template <class T, uint32_t Kinds, int W> class Slice {
   // answers first, Embree only where it is unsure. With k the rays are read in place
   // from the pool's arrays (copied into the packet only for Embree).
   void closest(uint32_t base, const uint32_t* slots, int n, uint32_t* prim) {
-    RTCRayHitNt<W>& p = hit_packet_;
     // tfar and geomID hold their start values here (reset_packet after each Embree call).
     if (k_) {
       const float* rays[6];
       for (int j = 0; j < 6; ++j) rays[j] = pool_.ray[j].data() + base;
-      if (tiny_) {
-        if (tiny_closest<W>(*k_, *tiny_, job_.embree, ctx_, rays, p, n, prim) > 0) reset_packet(p);
-        return;
-      }
-      copy_rays<W>(rays, p.ray);
-    } else {
-      for (int i = 0; i < n; ++i) set_lane(p.ray, i, pool_.state[slots[i]].ray, kInfinity);
+      closest_hits<W>(*k_, tiny_, job_.embree, ctx_, rays, hit_packet_, n, prim);
+      return;
     }
-    alignas(64) int valid[W];
-    for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-    intersect_packet(valid, job_.embree.handle(), &ctx_, p);
-    for (int i = 0; i < n; ++i) prim[i] = packet_triangle(job_.embree, p, i);
-    reset_packet(p);
+    for (int i = 0; i < n; ++i) set_lane(hit_packet_.ray, i, pool_.state[slots[i]].ray, kInfinity);
+    embree_closest<W>(job_.embree, ctx_, hit_packet_, n, prim);
   }
 
   // A packet's hits into the shading batch (as shade() does, with the pool's pointers and
@@ -335,15 +323,11 @@ template <class T, uint32_t Kinds, int W> class Slice {
     const float* rays[6];
     for (int j = 0; j < 6; ++j) rays[j] = sb.ray[j];
     bool blocked[W];  // tfar holds 1 here (reset_packet after each Embree call)
-    if (tiny_) {
-      if (tiny_occluded<W>(*k_, *tiny_, job_.embree, ctx_, rays, p, n, blocked) > 0) reset_packet(p);
+    if (k_) {
+      shadows_blocked<W>(*k_, tiny_, job_.embree, ctx_, rays, p, n, blocked);
     } else {
       copy_rays<W>(rays, p);
-      alignas(64) int valid[W];
-      for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-      occluded_packet(valid, job_.embree.handle(), &ctx_, p);
-      for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
-      reset_packet(p);
+      embree_occluded<W>(job_.embree, ctx_, p, n, blocked);
     }
     for (int i = 0; i < n; ++i) {
       const uint32_t slot = sb.tag[i] & ~ShadeStream::kEnds;

@@ -129,4 +129,46 @@ int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& 
   return __builtin_popcount(unsure);
 }
 
+// Embree's closest hits for packet p's lanes [0, n) (rays and tfar set), as scene
+// triangles (or RTC_INVALID_GEOMETRY_ID) in prim; p's tfar and geomID reset after.
+template <int W> void embree_closest(const EmbreeScene& e, RTCIntersectContext& ctx, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  intersect_packet(valid, e.handle(), &ctx, p);
+  for (int i = 0; i < n; ++i) prim[i] = packet_triangle(e, p, i);
+  reset_packet(p);
+}
+// Embree's answer whether each of packet p's shadow rays [0, n) is blocked; tfar reset after.
+template <int W> void embree_occluded(const EmbreeScene& e, RTCIntersectContext& ctx, RTCRayNt<W>& p, int n, bool* blocked) {
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  occluded_packet(valid, e.handle(), &ctx, p);
+  for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
+  reset_packet(p);
+}
+
+// The batched strategies' packets, their rays as six arrays (p's own or the caller's,
+// e.g. the shading's streams) and p's tfar / geomID at their start values: the tiny
+// test first where there is one, otherwise Embree (the rays copied into p).
+template <int W>
+void closest_hits(const BatchKernels& k, const TinyScene* tiny, const EmbreeScene& e, RTCIntersectContext& ctx,
+                  const float* const* rays, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
+  if (tiny) {
+    if (tiny_closest<W>(k, *tiny, e, ctx, rays, p, n, prim) > 0) reset_packet(p);
+    return;
+  }
+  copy_rays<W>(rays, p.ray);
+  embree_closest<W>(e, ctx, p, n, prim);
+}
+template <int W>
+void shadows_blocked(const BatchKernels& k, const TinyScene* tiny, const EmbreeScene& e, RTCIntersectContext& ctx,
+                     const float* const* rays, RTCRayNt<W>& p, int n, bool* blocked) {
+  if (tiny) {
+    if (tiny_occluded<W>(k, *tiny, e, ctx, rays, p, n, blocked) > 0) reset_packet(p);
+    return;
+  }
+  copy_rays<W>(rays, p);
+  embree_occluded<W>(e, ctx, p, n, blocked);
+}
+
 }  // namespace pb::cpu
