@@ -59,7 +59,7 @@ template <class V, class E> struct LaneTable {
 inline void pick_emitters(const SceneView& s, IV pick, FV& u, UV& light) {
   const LaneTable<FV, float> cdf(s.emitter_cdf, s.num_emitters);
   IV lo = IV{}, hi = splat_i(int32_t(s.num_emitters) - 1);
-  for (IV active = lo < hi; any(active); active = lo < hi) {
+  for (IV active = lo < hi; lane_mask(active) != 0; active = lo < hi) {
     const IV mid = IV(UV(lo + hi) >> 1);  // (lo + hi) / 2, unsigned
     const IV left = u < cdf(mid);
     hi = select_i(active & left, mid, hi);

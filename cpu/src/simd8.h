@@ -52,13 +52,8 @@ inline V3 select(IV m, V3 a, V3 b) { return {m ? a.x : b.x, m ? a.y : b.y, m ? a
 // pmin / pmax of math.h, lane-wise: the same comparison picks the same operand (NaN too).
 inline FV vmin(FV a, FV b) { return a < b ? a : b; }
 inline FV vmax(FV a, FV b) { return a > b ? a : b; }
-inline bool any(IV m) {
-  for (int i = 0; i < kLanes; ++i)
-    if (m[i]) return true;
-  return false;
-}
-
-// Bit i: lane i of mask m is set (movemask; any() tests lane by lane).
+// Bit i: lane i of mask m is set (movemask: "any lane" is lane_mask(m) != 0, one
+// instruction, where a loop over the lanes tests them one by one).
 #if PB_SIMD_LANES == 16
 inline uint32_t lane_mask(IV m) { return uint32_t(_mm512_movepi32_mask(__m512i(m))); }
 #else

@@ -127,7 +127,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     Depth z;
     if constexpr (AnyHit) {
       z = depth();
-      if (lane_mask(~z.away) == 0) continue;  // (movemask: any() tests lane by lane)
+      if (lane_mask(~z.away) == 0) continue;
       ed = edges();
     } else {
       ed = edges();
