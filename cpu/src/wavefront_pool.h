@@ -23,11 +23,13 @@ namespace {
 // pixel, whose sums stay in cache (pixel-fastest order touched every film line once per
 // pass over the image: a miss, under a locked add, per path; cpu/NOTES.md). The order
 // cannot change the image: each path's numbers come from its (pixel, sample) alone, and
-// the film's sums are integers.
+// the film's sums are integers. Pixels [first_pixel, first_pixel + pixels), each with
+// samples [first_sample, first_sample + spp).
 class SampleSource {
  public:
-  SampleSource(uint32_t pixels, uint32_t spp, uint32_t first_sample, uint32_t group)
-      : total_(uint64_t(pixels) * spp), pixels_(pixels), spp_(spp), first_(first_sample), group_(std::max(1u, group)) {}
+  SampleSource(uint32_t first_pixel, uint32_t pixels, uint32_t spp, uint32_t first_sample, uint32_t group)
+      : total_(uint64_t(pixels) * spp), first_pixel_(first_pixel), end_pixel_(first_pixel + pixels), pixels_(pixels),
+        spp_(spp), first_(first_sample), group_(std::max(1u, group)) {}
   // Claims up to n samples; returns the first global index and sets n to the count.
   uint64_t claim(uint64_t& n) {
     uint64_t start = next_.fetch_add(n, std::memory_order_relaxed);
@@ -44,15 +46,16 @@ class SampleSource {
     const uint64_t k = std::min<uint64_t>(g / full, spp_ / group_);
     const uint32_t size = std::min(group_, spp_ - uint32_t(k) * group_);
     const uint64_t r = g - k * full;
-    return {uint32_t(r / size), first_ + uint32_t(k) * group_ + uint32_t(r % size), uint32_t(r % size), size};
+    return {first_pixel_ + uint32_t(r / size), first_ + uint32_t(k) * group_ + uint32_t(r % size), uint32_t(r % size),
+            size};
   }
   void step(Cursor& c) const {
     ++c.sample;
     if (++c.in_group < c.group_size) return;
     c.in_group = 0;
     c.sample -= c.group_size;
-    if (++c.pixel < pixels_) return;
-    c.pixel = 0;  // the next group of samples
+    if (++c.pixel < end_pixel_) return;
+    c.pixel = first_pixel_;  // the next group of samples
     c.sample += c.group_size;
     c.group_size = std::min(group_, first_ + spp_ - c.sample);
   }
@@ -60,7 +63,7 @@ class SampleSource {
  private:
   std::atomic<uint64_t> next_{0};
   uint64_t total_;
-  uint32_t pixels_, spp_;
+  uint32_t first_pixel_, end_pixel_, pixels_, spp_;
   uint32_t first_;  // samples [first_, first_ + spp_) of each pixel
   uint32_t group_;
 };
