@@ -2,6 +2,7 @@
 // Conversions between the path step's rays and Embree's ray structures.
 #include <embree3/rtcore.h>
 
+#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -99,21 +100,17 @@ template <int W> inline uint32_t packet_triangle(const EmbreeScene& e, const RTC
                                                     : e.triangle(p.hit.primID[i], p.hit.u[i], p.hit.v[i]);
 }
 
-// The rays of records[slots[0..n)] (path states or shadow queries, whose first six floats
-// are the ray) into a packet by one transpose (k->rays_to_packet, whose width is W;
-// lanes from n on repeat slot 0); false (nothing done) without kernels or for double
-// records, which the caller converts lane by lane (set_lane).
-template <int W, class Record, class Index>
-bool rays_to_packet(const BatchKernels* k, const Record* records, const Index* slots, int n, RTCRayNt<W>& r) {
-  if constexpr (std::is_same_v<Record, PathState<float>> || std::is_same_v<Record, ShadowQuery<float>>) {
-    if (!k) return false;
-    const void* rows[W];
-    for (int i = 0; i < W; ++i) rows[i] = &records[slots[i < n ? i : 0]];
-    float* const out[6] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z};
-    k->rays_to_packet(rows, out);
-    return true;
-  }
-  return false;
+// Rays kept as six arrays (org x, y, z, dir x, y, z: the shading kernel's streams,
+// ShadeStream) into packet `p`, unless they are its own arrays already.
+template <int W> void copy_rays(const float* const* rays, RTCRayNt<W>& p) {
+  float* const out[6] = {p.org_x, p.org_y, p.org_z, p.dir_x, p.dir_y, p.dir_z};
+  for (int j = 0; j < 6; ++j)
+    if (rays[j] != out[j]) std::memcpy(out[j], rays[j], sizeof(float) * W);
+}
+// A packet's ray arrays, as the kernels' streams and the tiny test name them.
+template <int W> void packet_arrays(RTCRayNt<W>& p, float** out) {
+  out[0] = p.org_x; out[1] = p.org_y; out[2] = p.org_z;
+  out[3] = p.dir_x; out[4] = p.dir_y; out[5] = p.dir_z;
 }
 
 }  // namespace pb::cpu

@@ -75,50 +75,19 @@ template <int W> struct PixelPackets {
   }
 };
 
-// The closest hits of the rays of st[idx[0..n)] (n <= W) as one packet (rays by the
-// kernels' transpose); with `tiny`, the tiny-scene test first (tiny_scene.h).
-template <int W>
-void closest_packet(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
-                    RTCRayHitNt<W>& p, const PathState<float>* st, const int* idx, int n, uint32_t* prim) {
-  rays_to_packet<W>(&k, st, idx, n, p.ray);  // tfar, geomID: at their start values (PixelPackets)
-  if (tiny) {
-    if (tiny_closest<W>(k, *tiny, e, ctx, p, n, prim) > 0) reset_packet(p);
-    return;
-  }
-  alignas(64) int valid[W];
-  for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
-  intersect_packet(valid, e.handle(), &ctx, p);
-  for (int j = 0; j < n; ++j) prim[j] = packet_triangle(e, p, j);
-  reset_packet(p);
-}
-// Whether each shadow ray q[idx[0..n)] (n <= W) is blocked, as one packet.
-template <int W>
-void occluded_packet_of(const EmbreeScene& e, const BatchKernels& k, const TinyScene* tiny, RTCIntersectContext& ctx,
-                        RTCRayNt<W>& p, const ShadowQuery<float>* q, const int* idx, int n, bool* blocked) {
-  rays_to_packet<W>(&k, q, idx, n, p);  // tfar: 1 (PixelPackets)
-  if (tiny) {
-    if (tiny_occluded<W>(k, *tiny, e, ctx, p, n, blocked) > 0) reset_packet(p);
-    return;
-  }
-  alignas(64) int valid[W];
-  for (int j = 0; j < W; ++j) valid[j] = j < n ? -1 : 0;
-  occluded_packet(valid, e.handle(), &ctx, p);
-  for (int j = 0; j < n; ++j) blocked[j] = p.tfar[j] < 0.0f;
-  reset_packet(p);
-}
-
 // Diffuse-only float renders with a vector ISA (batched_shading_table): up to W = k.lanes
 // samples of one pixel at a time, each its own path, traced together: their rays as one
 // packet of W (closest hits, then shadow rays), their path steps run together W wide
 // (shade_x8.h). Every path gets what trace_path would give it, bit for bit.
 // The live samples always share one depth (each vertex moves every one of them on by
-// one), so the last-vertex test and the ray counts are per batch, not per lane.
+// one), so the last-vertex test and the ray counts are per batch, not per lane. The
+// kernels write the rays straight into the packets (begin_paths; the shading's `next`
+// and `shadow` streams, whose lane order is the live list's), so no ray is transposed.
 template <int W>
 PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernels& k, const ShadeTable& table,
                                           const TinyScene* tiny, RTCIntersectContext& ctx, PixelPackets<W>& packets,
                                           uint32_t pixel, uint32_t first_sample, int count, Local& local) {
   alignas(64) PathState<float> st[W];
-  ShadowQuery<float> q[W];
   PathState<float>* lanes[W];
   uint32_t pixels[W], samples[W];
   for (int i = 0; i < W; ++i) {
@@ -126,9 +95,21 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     pixels[i] = pixel;
     samples[i] = first_sample + uint32_t(i < count ? i : 0);
   }
-  k.begin_paths(job.scene, job.config, pixels, samples, lanes, count);
-  int live[W], n_live = count;
-  for (int i = 0; i < count; ++i) live[i] = i;
+  float* hit_rays[6];
+  packet_arrays(packets.hit.ray, hit_rays);
+  k.begin_paths(job.scene, job.config, pixels, samples, lanes, count, hit_rays);
+  // The shading's streams: next rays into the hit packet, shadow rays into the shadow
+  // packet; tags are indices into st.
+  uint32_t live[W], shadowed[W];
+  alignas(64) float contribution[3][W];
+  ShadeStream next{}, shadow{};
+  for (int j = 0; j < 6; ++j) next.ray[j] = hit_rays[j];
+  next.tag = live;
+  packet_arrays(packets.shadow, shadow.ray);
+  for (int j = 0; j < 3; ++j) shadow.contribution[j] = contribution[j];
+  shadow.tag = shadowed;
+  int n_live = count;
+  for (int i = 0; i < count; ++i) live[i] = uint32_t(i);
   while (n_live > 0) {
     const uint32_t depth = st[live[0]].depth;  // every live sample's
     if (path_at_final_vertex(job.scene, job.config, st[live[0]])) {
@@ -138,50 +119,50 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
       bool candidate[W];
       k.final_vertex_candidates(job.scene, at_final, candidate);
       for (int j = 0; j < n_live; ++j) {
-        const int i = live[j];
-        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, st[i], q[i])) {
+        ShadowQuery<float> q;
+        PathState<float>& s = st[live[j]];
+        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, s, q)) {
           count_ray(local.rays, depth, &RayCounts::shadow);
-          if (!occluded(job.embree, ctx, q[i].ray, 1.0f)) shadow_unoccluded(st[i], q[i]);
+          if (!occluded(job.embree, ctx, q.ray, 1.0f)) shadow_unoccluded(s, q);
         }
       }
       break;
     }
     // Closest hits (one packet); misses end their paths.
     uint32_t hit[W];
-    closest_packet<W>(job.embree, k, tiny, ctx, packets.hit, st, live, n_live, hit);
+    closest_hits<W>(k, tiny, job.embree, ctx, hit_rays, packets.hit, n_live, hit);  // tfar, geomID: PixelPackets
     (depth == 0 ? local.rays.camera : local.rays.bounce) += uint64_t(n_live);
     ShadeBatch batch;
     batch.lanes = 0;
     for (int j = 0; j < n_live; ++j) {
-      const int i = live[j];
       if (hit[j] == RTC_INVALID_GEOMETRY_ID) continue;
+      const uint32_t i = live[j];
       batch.st[batch.lanes] = &st[i];
-      batch.shadow[batch.lanes] = &q[i];
       batch.prim[batch.lanes] = hit[j];
-      live[batch.lanes++] = i;
+      batch.tag[batch.lanes++] = i;
     }
-    n_live = batch.lanes;
-    if (n_live == 0) break;
-    for (int j = n_live; j < W; ++j) {
+    if (batch.lanes == 0) break;
+    for (int j = batch.lanes; j < W; ++j) {
       batch.st[j] = batch.st[0];
-      batch.shadow[j] = batch.shadow[0];
       batch.prim[j] = batch.prim[0];
+      batch.tag[j] = batch.tag[0];
     }
+    next.n = shadow.n = 0;
+    batch.next = &next;
+    batch.shadow = &shadow;
     k.shade_diffuse(job.scene, job.config, table, batch);
-    int keep = 0, shadowed[W], n_shadowed = 0;
-    for (int j = 0; j < n_live; ++j) {
-      const int i = live[j];
-      if (batch.wants_shadow[j]) shadowed[n_shadowed++] = i;
-      if (batch.cont[j]) live[keep++] = i;
-    }
-    if (n_shadowed > 0) {
+    if (shadow.n > 0) {
+      const int n_shadowed = int(shadow.n);
       local.rays.shadow += uint64_t(n_shadowed);  // depth >= 0 here: never a camera ray
       bool blocked[W];
-      occluded_packet_of<W>(job.embree, k, tiny, ctx, packets.shadow, q, shadowed, n_shadowed, blocked);
+      shadows_blocked<W>(k, tiny, job.embree, ctx, shadow.ray, packets.shadow, n_shadowed, blocked);  // tfar: 1
       for (int j = 0; j < n_shadowed; ++j)
-        if (!blocked[j]) shadow_unoccluded(st[shadowed[j]], q[shadowed[j]]);
+        if (!blocked[j]) {
+          Vec3f& L = st[shadowed[j] & ~ShadeStream::kEnds].L;  // shadow_unoccluded
+          L += Vec3f{contribution[0][j], contribution[1][j], contribution[2][j]};
+        }
     }
-    n_live = keep;
+    n_live = int(next.n);
   }
   for (int i = 0; i < count; ++i) {
     ++local.paths;

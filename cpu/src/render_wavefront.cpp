@@ -8,9 +8,11 @@
 // The pass is one loop, not a stage per list: a packet's hits go straight into the
 // shading batch, shading routes each path at once (on in `live`, compacted in place; to
 // `final`; ended: to the film and `free`), so no list is rebuilt and no path is looked
-// at twice per round (cpu/NOTES.md, "Item 5, queue management", measures it). Per path
-// the order stays the path step's: a vertex's shadow ray is answered before the path's
-// next vertex is shaded (every pending shadow packet is traced by the end of the pass).
+// at twice per round (cpu/NOTES.md, "Item 5, queue management"). With the batched path
+// step the kernel routes, writing the next rays where the next packet reads them
+// (PoolSlice::ray, PendingShadows; cpu/NOTES.md, "SoA hand-over"). Per path the order
+// stays the path step's: a vertex's shadow ray is answered before the path's next
+// vertex is shaded (every pending shadow packet is traced by the end of the pass).
 // The film sums are integers, so the order in which paths reach it does not matter.
 // Diffuse-only float renders with a vector ISA (--isa; the paper's benchmark) run
 // generate, final vertex and shade a vector's width of paths at a time (BatchKernels,
@@ -33,6 +35,7 @@
 #include <vector>
 
 #include "embree_rays.h"
+#include "film_combiner.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
@@ -49,10 +52,8 @@ namespace pb::cpu {
 namespace {
 
 // Packet width W: the batch's width, so one batch of rays is one packet: 16 with
-// AVX-512 (Embree's AVX-512 kernels trace 16 natively), 8 with AVX2 and for the scalar
-// path step. (Measured with callgrind on an AVX2 machine: 16-wide packets ran through
-// the same Embree kernel at the same instruction count there.)
-// (intersect_packet, occluded_packet: embree_rays.h.)
+// AVX-512, 8 with AVX2 and for the scalar path step. (closest_hits, shadows_blocked,
+// embree_closest, embree_occluded: tiny_scene.h.)
 
 // One thread's slice and the stages over it, in scalar type T, compiled for the material
 // kinds `Kinds` (features.h), with packets of W rays; `k` (width W) and `table` where the
@@ -62,7 +63,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
  public:
   Slice(const TraceJob& job, const BatchKernels* k, const ShadeTable* table, const TinyScene* tiny, SampleSource& src,
         size_t paths, Local& local)
-      : job_(job), k_(k), table_(table), tiny_(tiny), src_(src), pool_(paths), local_(local) {
+      : job_(job), k_(k), table_(table), tiny_(tiny), src_(src), pool_(paths, k != nullptr), local_(local), film_(job.film) {
     rtcInitIntersectContext(&ctx_);
     // path_at_final_vertex as one compare of the depth.
     if (job.config.max_bounces >= 0 && job.scene.num_emitters <= kMaxEmittersForFinalQuery)
@@ -80,10 +81,11 @@ template <class T, uint32_t Kinds, int W> class Slice {
       finished_ = 0;
       final_vertex();
       trace_live();
-      if (n_shadow_ > 0) trace_shadows();
+      if (shadows_.n > 0) trace_shadows();
       local_.paths += finished_;
       job_.progress.advance(finished_);
     }
+    film_.flush();
     // Every closest-hit query of a depth-0 path is its camera ray (count_ray).
     local_.rays.camera += camera_;
     local_.rays.bounce += closest_ - camera_;
@@ -100,14 +102,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
     std::vector<uint32_t>& to = at_final ? pool_.final : pool_.live;
     uint32_t& count = at_final ? pool_.n_final : pool_.n_live;
     if (!at_final) camera_ += n;
-    uint32_t pixel = src_.pixel_of(start), sample = src_.sample_of(start);
-    const uint32_t first_pixel = src_.first_pixel(), end_pixel = src_.end_pixel();
-    auto next = [&] {  // (pixel, sample) of the next global index, without a division
-      if (++pixel == end_pixel) {
-        pixel = first_pixel;
-        ++sample;
-      }
-    };
+    SampleSource::Cursor at = src_.at(start);
     uint32_t* free = pool_.free.data();
     uint32_t n_free = pool_.n_free, out = count;
     if constexpr (std::is_same_v<T, float>) {
@@ -115,12 +110,15 @@ template <class T, uint32_t Kinds, int W> class Slice {
         const int width = k_->lanes;
         for (uint64_t i = 0; i < n; i += uint64_t(width)) {
           const int lanes = int(std::min<uint64_t>(uint64_t(width), n - i));
+          // Live paths' rays by their place in `live` (final ones: only the state's).
+          float* rays[6];
+          for (int j = 0; j < 6; ++j) rays[j] = pool_.ray[j].data() + out;
           uint32_t px[kMaxShadeLanes], smp[kMaxShadeLanes];
           PathState<float>* st[kMaxShadeLanes];
           for (int l = 0; l < lanes; ++l) {
-            px[l] = pixel;
-            smp[l] = sample;
-            next();
+            px[l] = at.pixel;
+            smp[l] = at.sample;
+            src_.step(at);
             const uint32_t slot = free[--n_free];
             st[l] = &pool_.state[slot];
             to[out++] = slot;
@@ -130,16 +128,16 @@ template <class T, uint32_t Kinds, int W> class Slice {
             smp[l] = smp[0];
             st[l] = st[0];
           }
-          k_->begin_paths(job_.scene, job_.config, px, smp, st, lanes);
+          k_->begin_paths(job_.scene, job_.config, px, smp, st, lanes, at_final ? nullptr : rays);
         }
         pool_.n_free = n_free;
         count = out;
         return;
       }
     }
-    for (uint64_t i = 0; i < n; ++i, next()) {
+    for (uint64_t i = 0; i < n; ++i, src_.step(at)) {
       const uint32_t slot = free[--n_free];
-      path_begin(job_.scene, job_.config, pixel, sample, pool_.state[slot]);
+      path_begin(job_.scene, job_.config, at.pixel, at.sample, pool_.state[slot]);
       to[out++] = slot;
     }
     pool_.n_free = n_free;
@@ -156,9 +154,10 @@ template <class T, uint32_t Kinds, int W> class Slice {
     pool_.n_final = 0;
     auto query = [&](uint32_t slot) {
       const PathState<T>& st = pool_.state[slot];
-      if (path_final_query<Kinds>(job_.scene, job_.config, st, pool_.shadow[slot])) {
+      ShadowQuery<T> q;
+      if (path_final_query<Kinds>(job_.scene, job_.config, st, q)) {
         count_ray(local_.rays, st.depth, &RayCounts::shadow);
-        queue_shadow(slot, true);
+        queue_shadow(slot | ShadeStream::kEnds, q);
       } else {
         finish(slot);
       }
@@ -197,7 +196,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
       // which were read before (lane i's slot is read before any path after it is routed).
       const uint32_t* slots = &pool_.live[base];
       uint32_t prim[W];
-      closest(slots, n, prim);
+      closest(base, slots, n, prim);
       if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
         if (table_) {
           batch_hits(slots, prim, n);
@@ -214,24 +213,20 @@ template <class T, uint32_t Kinds, int W> class Slice {
     pool_.n_live = keep_;
   }
 
-  // The hit triangle (or RTC_INVALID_GEOMETRY_ID) of each of the n <= W paths' rays: one
-  // packet; with `tiny` (and k) the tiny-scene test answers first, Embree only where it
-  // is unsure.
-  void closest(const uint32_t* slots, int n, uint32_t* prim) {
-    RTCRayHitNt<W>& p = hit_packet_;
-    const bool filled = rays_to_packet<W>(k_, pool_.state.data(), slots, n, p.ray);
-    if (!filled)
-      for (int i = 0; i < n; ++i) set_lane(p.ray, i, pool_.state[slots[i]].ray, kInfinity);
+  // The hit triangle (or RTC_INVALID_GEOMETRY_ID) of each of the n <= W paths' rays
+  // (those of live[base, base + n)): one packet; with `tiny` (and k) the tiny-scene test
+  // answers first, Embree only where it is unsure. With k the rays are read in place
+  // from the pool's arrays (copied into the packet only for Embree).
+  void closest(uint32_t base, const uint32_t* slots, int n, uint32_t* prim) {
     // tfar and geomID hold their start values here (reset_packet after each Embree call).
-    if (tiny_ && filled) {
-      if (tiny_closest<W>(*k_, *tiny_, job_.embree, ctx_, p, n, prim) > 0) reset_packet(p);
+    if (k_) {
+      const float* rays[6];
+      for (int j = 0; j < 6; ++j) rays[j] = pool_.ray[j].data() + base;
+      closest_hits<W>(*k_, tiny_, job_.embree, ctx_, rays, hit_packet_, n, prim);
       return;
     }
-    alignas(64) int valid[W];
-    for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-    intersect_packet(valid, job_.embree.handle(), &ctx_, p);
-    for (int i = 0; i < n; ++i) prim[i] = packet_triangle(job_.embree, p, i);
-    reset_packet(p);
+    for (int i = 0; i < n; ++i) set_lane(hit_packet_.ray, i, pool_.state[slots[i]].ray, kInfinity);
+    embree_closest<W>(job_.embree, ctx_, hit_packet_, n, prim);
   }
 
   // A packet's hits into the shading batch (as shade() does, with the pool's pointers and
@@ -239,7 +234,6 @@ template <class T, uint32_t Kinds, int W> class Slice {
   void batch_hits(const uint32_t* slots, const uint32_t* prim, int n) {
     if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
       PathState<float>* const state = pool_.state.data();
-      ShadowQuery<float>* const shadow = pool_.shadow.data();
       int b = batch_.lanes;
       for (int i = 0; i < n; ++i) {
         const uint32_t slot = slots[i];
@@ -248,9 +242,8 @@ template <class T, uint32_t Kinds, int W> class Slice {
           continue;
         }
         batch_.st[b] = state + slot;
-        batch_.shadow[b] = shadow + slot;
         batch_.prim[b] = prim[i];
-        batch_slot_[b] = slot;
+        batch_.tag[b] = slot;
         if (++b == W) {
           batch_.lanes = W;
           shade_batch();
@@ -265,78 +258,89 @@ template <class T, uint32_t Kinds, int W> class Slice {
   void shade(uint32_t slot, uint32_t prim) {
     PathState<T>& st = pool_.state[slot];
     bool wants_shadow;
-    const PathEvent ev =
-        path_hit<Kinds>(job_.scene, job_.config, st, surface_hit(job_.scene, prim, st.ray), pool_.shadow[slot], wants_shadow);
-    route(slot, wants_shadow, ev == PathEvent::Continue);
-  }
-
-  // The batch's paths through k.shade_diffuse (shade_x8.h), bit-identical to path_hit.
-  void shade_batch() {
-    if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
-      const int lanes = batch_.lanes;
-      for (int i = lanes; i < W; ++i) {  // idle lanes repeat lane 0
-        batch_.st[i] = batch_.st[0];
-        batch_.shadow[i] = batch_.shadow[0];
-        batch_.prim[i] = batch_.prim[0];
-      }
-      k_->shade_diffuse(job_.scene, job_.config, *table_, batch_);
-      batch_.lanes = 0;
-      for (int i = 0; i < lanes; ++i) route(batch_slot_[i], batch_.wants_shadow[i], batch_.cont[i]);
-    }
-  }
-
-  // Where a shaded path goes: its shadow ray to the pending packet; the path back to
-  // `live`, to `final` (its next vertex is its last), or, ended, to the film (after its
-  // shadow ray, if any).
-  void route(uint32_t slot, bool wants_shadow, bool cont) {
+    ShadowQuery<T> q;
+    const PathEvent ev = path_hit<Kinds>(job_.scene, job_.config, st, surface_hit(job_.scene, prim, st.ray), q, wants_shadow);
+    const bool cont = ev == PathEvent::Continue;
     if (wants_shadow) {
       ++local_.rays.shadow;
-      queue_shadow(slot, !cont);
+      queue_shadow(cont ? slot : slot | ShadeStream::kEnds, q);
     }
     if (cont) {
-      if (pool_.state[slot].depth >= final_depth_) pool_.final[pool_.n_final++] = slot;
+      if (st.depth >= final_depth_) pool_.final[pool_.n_final++] = slot;
       else pool_.live[keep_++] = slot;
     } else if (!wants_shadow) {
       finish(slot);
     }
   }
 
-  // A shadow ray waits for a full packet; `ends`: its path is done once it is answered.
-  void queue_shadow(uint32_t slot, bool ends) {
-    shadow_slot_[n_shadow_] = slot;
-    shadow_ends_[n_shadow_] = ends;
-    if (++n_shadow_ == W) trace_shadows();
+  // The batch's paths through k.shade_diffuse (shade_x8.h), bit-identical to path_hit;
+  // the kernel routes them (ShadeBatch's streams): going on to `live` (its rays to the
+  // pool's arrays at the same place) or `final`, shadow rays to the pending ones; the
+  // paths that ended without one go to the film here.
+  void shade_batch() {
+    if constexpr (std::is_same_v<T, float> && Kinds == kDiffuseOnly) {
+      ShadeBatch& b = batch_;
+      const int lanes = b.lanes;
+      for (int i = lanes; i < W; ++i) {  // idle lanes repeat lane 0
+        b.st[i] = b.st[0];
+        b.prim[i] = b.prim[0];
+        b.tag[i] = b.tag[0];
+      }
+      ShadeStream next{}, to_final{}, shadow = shadows_.stream();
+      for (int j = 0; j < 6; ++j) next.ray[j] = pool_.ray[j].data();
+      next.tag = pool_.live.data();
+      next.n = keep_;
+      to_final.tag = pool_.final.data();
+      to_final.n = pool_.n_final;
+      b.final_depth = final_depth_;
+      b.next = &next;
+      b.final = &to_final;
+      b.shadow = &shadow;
+      k_->shade_diffuse(job_.scene, job_.config, *table_, b);
+      b.lanes = 0;
+      keep_ = next.n;
+      pool_.n_final = to_final.n;
+      local_.rays.shadow += shadow.n - shadows_.n;
+      shadows_.n = shadow.n;
+      for (uint32_t done = b.done; done != 0; done &= done - 1) finish(b.tag[__builtin_ctz(done)]);
+      while (shadows_.n >= uint32_t(W)) trace_shadows();
+    }
   }
 
-  // The pending shadow rays as one packet (the tiny test first where it applies).
+  // A shadow ray (slot | ShadeStream::kEnds where its path is done once it is answered)
+  // waits for a full packet.
+  void queue_shadow(uint32_t slot_and_ends, const ShadowQuery<T>& q) {
+    shadows_.push(slot_and_ends, q);
+    if (shadows_.n == uint32_t(W)) trace_shadows();
+  }
+
+  // The first W (or fewer, at the end of a pass) pending shadow rays as one packet (the
+  // tiny test first where it applies).
   void trace_shadows() {
-    const int n = n_shadow_;
-    n_shadow_ = 0;
-    const uint32_t* slots = shadow_slot_;
+    PendingShadows<T, W>& sb = shadows_;
+    const int n = int(std::min<uint32_t>(sb.n, W));
     RTCRayNt<W>& p = shadow_packet_;
-    const bool filled = rays_to_packet<W>(k_, pool_.shadow.data(), slots, n, p);
-    if (!filled)
-      for (int i = 0; i < n; ++i) set_lane(p, i, pool_.shadow[slots[i]].ray, 1.0f);
+    const float* rays[6];
+    for (int j = 0; j < 6; ++j) rays[j] = sb.ray[j];
     bool blocked[W];  // tfar holds 1 here (reset_packet after each Embree call)
-    if (tiny_ && filled) {
-      if (tiny_occluded<W>(*k_, *tiny_, job_.embree, ctx_, p, n, blocked) > 0) reset_packet(p);
+    if (k_) {
+      shadows_blocked<W>(*k_, tiny_, job_.embree, ctx_, rays, p, n, blocked);
     } else {
-      alignas(64) int valid[W];
-      for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-      occluded_packet(valid, job_.embree.handle(), &ctx_, p);
-      for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
-      reset_packet(p);
+      copy_rays<W>(rays, p);
+      embree_occluded<W>(job_.embree, ctx_, p, n, blocked);
     }
     for (int i = 0; i < n; ++i) {
-      const uint32_t slot = slots[i];
-      if (!blocked[i]) shadow_unoccluded(pool_.state[slot], pool_.shadow[slot]);
-      if (shadow_ends_[i]) finish(slot);
+      const uint32_t slot = sb.tag[i] & ~ShadeStream::kEnds;
+      if (!blocked[i])  // shadow_unoccluded
+        pool_.state[slot].L += Vec3<T>{sb.contribution[0][i], sb.contribution[1][i], sb.contribution[2][i]};
+      if (sb.tag[i] & ShadeStream::kEnds) finish(slot);
     }
+    sb.drop(uint32_t(n));
   }
 
   // A path is done: its radiance to the film, its slot free.
   void finish(uint32_t slot) {
-    if (!job_.film.add_atomic(pool_.state[slot].pixel, Vec3f(pool_.state[slot].L))) ++local_.discarded;
+    if (!film_.add(pool_.state[slot].pixel, Vec3f(pool_.state[slot].L))) ++local_.discarded;
     pool_.free[pool_.n_free++] = slot;
     ++finished_;
   }
@@ -348,15 +352,13 @@ template <class T, uint32_t Kinds, int W> class Slice {
   SampleSource& src_;
   PoolSlice<T> pool_;
   Local& local_;
+  FilmCombiner film_;
   RTCIntersectContext ctx_;
   uint32_t final_depth_ = std::numeric_limits<uint32_t>::max();  // never, without the final query
   alignas(64) RTCRayHitNt<W> hit_packet_;
   alignas(64) RTCRayNt<W> shadow_packet_;
-  ShadeBatch batch_{};
-  uint32_t batch_slot_[kMaxShadeLanes];
-  uint32_t shadow_slot_[W];
-  bool shadow_ends_[W];
-  int n_shadow_ = 0;
+  ShadeBatch batch_{};  // tags: pool slots
+  PendingShadows<T, W> shadows_;
   uint32_t keep_ = 0;                            // paths kept in `live` by the pass so far
   uint64_t finished_ = 0;                        // paths done this round
   uint64_t camera_ = 0, closest_ = 0;            // closest-hit queries: of new paths, in all
@@ -366,8 +368,8 @@ template <class T, uint32_t Kinds, int W> class Slice {
 template <class T, uint32_t Kinds, int W>
 TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
                       std::unique_ptr<ShadeTable> table) {
-  const uint32_t pixels = job.config.width * job.rows;
-  SampleSource source(uint64_t(pixels) * job.spp, job.config.first_pixel, pixels, job.config.first_sample);
+  // Whole rows from first_pixel on (an MPI rank's band, or the frame).
+  SampleSource source(job.config.first_pixel, job.config.width * job.rows, job.spp, job.config.first_sample, W);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
   // A pool that cannot fit is a setting to lower, not a std::bad_alloc (exit 2, not 1).

@@ -3,7 +3,7 @@
 // the scalar path step.
 #define PB_SIMD_NS avx512
 #define PB_SIMD_LANES 16
-#define PB_SIMD_TARGET "avx512f,avx512bw,avx512dq,avx512vl"
+#define PB_SIMD_TARGET "avx512f,avx512bw,avx512dq,avx512vl,popcnt"
 #define PB_SIMD_ISA Avx512
 #define PB_SIMD_KERNELS avx512_kernels
 #include "shade_kernels.inc"

@@ -20,15 +20,33 @@ struct TinyScene;  // tiny_scene.h
 // kernel reads its own width of them.
 constexpr int kMaxShadeLanes = 16;
 
-// One batch: up to a kernel's width of paths that hit a triangle, and what shading them
-// asks for next.
+// Where the shading kernel appends the lanes of one kind (ShadeBatch::next, ::final,
+// ::shadow), packed in lane order, as structures of arrays: the rays land where the next
+// packet is traced from (an Embree packet's org/dir arrays, or the wavefront's live
+// rays), with no per-lane loop and no transpose (cpu/NOTES.md, "SoA hand-over").
+struct ShadeStream {
+  float* ray[6];           // org x, y, z, dir x, y, z (unused by the final stream)
+  float* contribution[3];  // the shadow stream's: added to L where the ray is unoccluded
+  uint32_t* tag;           // the lane's ShadeBatch::tag (shadow stream: | kEnds where the path ends)
+  uint32_t n;              // entries so far: the kernel appends at n and advances it
+  static constexpr uint32_t kEnds = 0x80000000u;
+};
+
+// One batch: up to a kernel's width of paths that hit a triangle, and where shading them
+// sends each one. Every used lane goes to exactly one of: `next` (goes on, its next
+// vertex before final_depth), `final` (goes on to its last vertex: depth >= final_depth
+// after this one), `done` (ended, no shadow ray), or `shadow` only (ended; done once its
+// shadow ray is answered); a path going on may be in `shadow` too.
 struct ShadeBatch {
   PathState<float>* st[kMaxShadeLanes];
-  ShadowQuery<float>* shadow[kMaxShadeLanes];
   uint32_t prim[kMaxShadeLanes];  // hit triangle of each lane
+  uint32_t tag[kMaxShadeLanes];   // the caller's name for each lane (a pool slot, a sample)
   int lanes;                      // lanes in use; the rest repeat lane 0 and write nothing
-  bool wants_shadow[kMaxShadeLanes];
-  bool cont[kMaxShadeLanes];      // PathEvent::Continue
+  uint32_t final_depth = ~0u;     // a lane going on to this depth goes to `final`
+  ShadeStream* next = nullptr;    // rays (origin, direction) and tags
+  ShadeStream* final = nullptr;   // tags (may be null where final_depth is never reached)
+  ShadeStream* shadow = nullptr;  // shadow rays (origin, segment), contributions, tags
+  uint32_t done;                  // out: bit i, lane i ended without a shadow ray
 };
 
 // Per triangle, everything shading reads of it, as three rows of eight floats so eight
@@ -73,20 +91,20 @@ struct ShadeTable {
 struct BatchKernels {
   Isa isa;
   int lanes;
-  // path_begin for `lanes` paths (the first `used` of them are stored).
+  // path_begin for `lanes` paths (the first `used` of them are stored); `rays`, unless
+  // null: their camera rays also to rays[0..6)[0..used) (org x, y, z, dir x, y, z).
   void (*begin_paths)(const SceneView&, const PathConfig&, const uint32_t* pixel, const uint32_t* sample,
-                      PathState<float>* const* st, int used);
+                      PathState<float>* const* st, int used, float* const* rays);
   // Whether an emitter may lie along each path's ray (false only where the scalar
   // path_final_query would find none).
   void (*final_vertex_candidates)(const SceneView&, PathState<float>* const* st, bool* candidate);
-  // surface_hit + path_hit for the batch's lanes (diffuse-only, float).
+  // surface_hit + path_hit for the batch's lanes (diffuse-only, float); its lanes to
+  // the batch's streams.
   void (*shade_diffuse)(const SceneView&, const PathConfig&, const ShadeTable&, ShadeBatch&);
-  // The rays (first six floats) of `lanes` records into an Embree packet's org/dir arrays.
-  void (*rays_to_packet)(const void* const* rows, float* const* org_dir);
   // sincos_turns<float> (sampling.h) of `lanes` turn fractions (for the tests).
   void (*sincos_turns)(const float* u, float* s, float* c);
-  // The tiny-scene test (tiny_x8.h) of `lanes` rays (org_dir: six arrays, as
-  // rays_to_packet fills; tfar: the packet's): closest hit (scene triangle, or
+  // The tiny-scene test (tiny_x8.h) of `lanes` rays (org_dir: six arrays, as an
+  // Embree packet's and the shading's streams; tfar: the packet's): closest hit (scene triangle, or
   // RTC_INVALID_GEOMETRY_ID) or blocked, per lane. Returns the lanes left unsure (bit i:
   // lane i), whose answer is Embree's to give.
   uint32_t (*tiny_closest)(const TinyScene&, const float* const* org_dir, const float* tfar, uint32_t* triangle);

@@ -24,8 +24,59 @@
 
 namespace pb::cpu::PB_SIMD_NS {
 
-// path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), *shadow[i], wants_shadow[i])
-// for every lane i < kLanes; `table` is built from `s`.
+// Lane i of table t[0..n) at idx[i] (< n): from a register by one permutation where the
+// table fits in one (paper-cornell's two emitters), else lane by lane (no branches).
+template <class V, class E> struct LaneTable {
+  LaneTable(const E* t, uint32_t n) : p(t), in_register(n <= uint32_t(kLanes)) {
+    if (in_register) {
+      E pad[kLanes] = {};
+      std::memcpy(pad, t, n * sizeof(E));
+      std::memcpy(&reg, pad, sizeof reg);
+    }
+  }
+  V operator()(IV idx) const {
+    if (in_register) {
+#if PB_SIMD_LANES == 16
+      return V(_mm512_permutexvar_ps(__m512i(idx), __m512(reg)));
+#else
+      return V(_mm256_permutevar8x32_ps(__m256(reg), __m256i(idx)));
+#endif
+    }
+    V out;
+    for (int i = 0; i < kLanes; ++i) out[i] = p[idx[i]];
+    return out;
+  }
+  const E* p;
+  bool in_register;
+  V reg{};
+};
+
+// pick_emitter (path.h) for the lanes in `pick`, lane-wise: the same binary search over
+// the emitters' CDF (each lane makes the comparisons the scalar search makes; lanes that
+// are done wait), then the same rescaling of u. The picked lanes get the emitter's
+// triangle in `light` and the rescaled u; the others keep theirs. (A scalar search per
+// lane was a quarter of this kernel's time at 16 lanes: a mispredicted branch per lane.)
+inline void pick_emitters(const SceneView& s, IV pick, FV& u, UV& light) {
+  const LaneTable<FV, float> cdf(s.emitter_cdf, s.num_emitters);
+  IV lo = IV{}, hi = splat_i(int32_t(s.num_emitters) - 1);
+  for (IV active = lo < hi; lane_mask(active) != 0; active = lo < hi) {
+    const IV mid = IV(UV(lo + hi) >> 1);  // (lo + hi) / 2, unsigned
+    const IV left = u < cdf(mid);
+    hi = select_i(active & left, mid, hi);
+    lo = select_i(active & ~left, mid + 1, lo);
+  }
+  const FV below = select(lo > 0, cdf(select_i(lo > 0, lo - 1, IV{})), splat(0.0f));
+  const FV width = cdf(lo) - below;
+  const FV picked = select(width > 0.0f, vmin((u - below) / width, splat(0x1.fffffep-1f)), splat(0.0f));
+  u = select(pick, picked, u);
+  const LaneTable<UV, uint32_t> emitters(s.emitters, s.num_emitters);
+  light = pick ? emitters(lo) : light;
+}
+
+// path_hit<kDiffuseOnly, float>(s, c, *st[i], surface_hit(s, prim[i], st[i]->ray), q, wants_shadow)
+// for every lane i < b.lanes; `table` is built from `s`. What path_hit returns goes to
+// the batch's streams (ShadeBatch): the shadow query's ray and contribution where
+// wants_shadow, the next ray where the path goes on, packed per kind (Packer).
 [[gnu::flatten]] inline void shade_diffuse(const SceneView& s, const PathConfig& c, const ShadeTable& table, ShadeBatch& b) {
   constexpr int N = kLanes;
   const bool nee = c.sampling == Sampling::Nee && s.num_emitters > 0;  // diffuse: never a delta BSDF
@@ -63,17 +114,11 @@ namespace pb::cpu::PB_SIMD_NS {
   const IV at_budget = c.max_bounces >= 0 ? (depth >= c.max_bounces) : IV{};  // depth is small: signed compare is exact
   const IV scatters = bits(tc[3]) & ~at_budget;
 
-  // Per lane: the emitter light sampling picks (scalar pick_emitter), then its rows.
-  uint32_t light[N];
-  for (int i = 0; i < N; ++i) {
-    light[i] = b.prim[i];  // any valid triangle where no emitter is chosen
-    if (nee && scatters[i]) {
-      float up = u_pick[i];
-      light[i] = s.emitters[pick_emitter(s, up)];
-      u_pick[i] = up;
-    }
-    tri_rows[i] = table.row(light[i]);
-  }
+  // The emitter light sampling picks (pick_emitters), then its rows.
+  UV light;
+  std::memcpy(&light, b.prim, sizeof light);  // any valid triangle where no emitter is chosen
+  if (nee) pick_emitters(s, scatters, u_pick, light);
+  for (int i = 0; i < N; ++i) tri_rows[i] = table.row(light[i]);
   FV la[N], lb[N], lc[N];
   load_rows(tri_rows, 0, la);
   load_rows(tri_rows, 8, lb);
@@ -107,7 +152,7 @@ namespace pb::cpu::PB_SIMD_NS {
 
   // 3. Light sampling.
   IV shadow = IV{};
-  V3 contribution, shadow_d;
+  V3 contribution{}, shadow_d{};
   if (nee) {
     const FV su = sqrt(u_pick);
     const FV tb1 = 1.0f - su, tb2 = u3 * su;
@@ -169,14 +214,35 @@ namespace pb::cpu::PB_SIMD_NS {
   for (int i = 0; i < N; ++i) out_rows[i] = b.st[i];
   store_rows(ra, out_rows, 0, b.lanes);
   store_rows(rb, out_rows, 8, b.lanes);
-  for (int i = 0; i < b.lanes; ++i) {
-    b.wants_shadow[i] = shadow[i] != 0;
-    b.cont[i] = cont[i] != 0;
-    if (shadow[i]) {
-      ShadowQuery<float>& q = *b.shadow[i];
-      q.ray = {{origin.x[i], origin.y[i], origin.z[i]}, {shadow_d.x[i], shadow_d.y[i], shadow_d.z[i]}};
-      q.contribution = {contribution.x[i], contribution.y[i], contribution.z[i]};
-    }
+
+  // The lanes to the caller's streams (ShadeBatch), each kind packed in lane order.
+  const uint32_t used = uint32_t((uint64_t(1) << b.lanes) - 1);
+  const uint32_t m_cont = lane_mask(cont) & used, m_shadow = lane_mask(shadow) & used;
+  const uint32_t m_final = m_cont & lane_mask(UV(vertex) >= (UV{} + b.final_depth));
+  b.done = used & ~m_cont & ~m_shadow;
+  UV tag;
+  std::memcpy(&tag, b.tag, sizeof tag);
+  if (ShadeStream* out = b.next) {
+    const Packer pk(m_cont & ~m_final);
+    const FV r[6] = {origin.x, origin.y, origin.z, wi_next.x, wi_next.y, wi_next.z};
+    for (int j = 0; j < 6; ++j) pk.store(out->ray[j] + out->n, r[j]);
+    pk.store(out->tag + out->n, tag);
+    out->n += uint32_t(pk.count);
+  }
+  if (ShadeStream* out = b.final; out && m_final) {
+    const Packer pk(m_final);
+    pk.store(out->tag + out->n, tag);
+    out->n += uint32_t(pk.count);
+  }
+  if (ShadeStream* out = b.shadow; out && m_shadow) {  // (m_shadow is 0 without nee)
+    const Packer pk(m_shadow);
+    const FV r[6] = {origin.x, origin.y, origin.z, shadow_d.x, shadow_d.y, shadow_d.z};
+    for (int j = 0; j < 6; ++j) pk.store(out->ray[j] + out->n, r[j]);
+    pk.store(out->contribution[0] + out->n, contribution.x);
+    pk.store(out->contribution[1] + out->n, contribution.y);
+    pk.store(out->contribution[2] + out->n, contribution.z);
+    pk.store(out->tag + out->n, tag | UV(cont ? IV{} : splat_i(int32_t(ShadeStream::kEnds))));
+    out->n += uint32_t(pk.count);
   }
 }
 
@@ -244,7 +310,7 @@ namespace pb::cpu::PB_SIMD_NS {
 // path_begin (path.h) for kLanes new paths: camera_ray (camera.h) lane-wise in its order
 // of operations, the camera's random numbers from rng_draw.
 inline void begin_paths(const SceneView& s, const PathConfig& c, const uint32_t* pixel, const uint32_t* sample,
-                        PathState<float>* const* st, int lanes) {
+                        PathState<float>* const* st, int lanes, float* const* rays) {
   constexpr int N = kLanes;
   UV pix, smp;
   IV px, py;
@@ -274,21 +340,8 @@ inline void begin_paths(const SceneView& s, const PathConfig& c, const uint32_t*
   for (int i = 0; i < N; ++i) out_rows[i] = st[i];
   store_rows(ra, out_rows, 0, lanes);
   store_rows(rb, out_rows, 8, lanes);
-}
-
-}  // namespace pb::cpu::PB_SIMD_NS
-
-namespace pb::cpu::PB_SIMD_NS {
-
-// A ray (the first six floats of each of kLanes records: PathState::ray, ShadowQuery::ray)
-// into the arrays of an Embree packet of kLanes rays (out: org_x, org_y, org_z, dir_x,
-// dir_y, dir_z): what set_lane (embree_rays.h) does for floats.
-inline void rays_to_packet(const void* const* rows, float* const* out) {
-  FV r[8];
-  load_rows(rows, 0, r);
-  // Unrolled: as a loop g++ stores each register through the stack in 16-byte halves.
-#pragma GCC unroll 6
-  for (int j = 0; j < 6; ++j) std::memcpy(out[j], &r[j], sizeof r[j]);
+  if (rays)
+    for (int j = 0; j < 6; ++j) store_first(rays[j], ra[j], lanes);
 }
 
 }  // namespace pb::cpu::PB_SIMD_NS

@@ -47,14 +47,72 @@ inline IV bits(FV v) { return (IV)v; }  // a cast between vector types of one si
 inline FV from_bits(IV v) { return (FV)v; }
 // m ? a : b per lane (m from a comparison).
 inline FV select(IV m, FV a, FV b) { return m ? a : b; }
+inline IV select_i(IV m, IV a, IV b) { return m ? a : b; }
 inline V3 select(IV m, V3 a, V3 b) { return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z}; }
 // pmin / pmax of math.h, lane-wise: the same comparison picks the same operand (NaN too).
 inline FV vmin(FV a, FV b) { return a < b ? a : b; }
 inline FV vmax(FV a, FV b) { return a > b ? a : b; }
-inline bool any(IV m) {
-  for (int i = 0; i < kLanes; ++i)
-    if (m[i]) return true;
-  return false;
+// Bit i: lane i of mask m is set (movemask: "any lane" is lane_mask(m) != 0, one
+// instruction, where a loop over the lanes tests them one by one).
+#if PB_SIMD_LANES == 16
+inline uint32_t lane_mask(IV m) { return uint32_t(_mm512_movepi32_mask(__m512i(m))); }
+#else
+inline uint32_t lane_mask(IV m) { return uint32_t(_mm256_movemask_ps(__m256(m))); }
+#endif
+
+#if PB_SIMD_LANES == 8
+// kPackOrder.v[m]: the set bits of m (8 bits) in increasing order, one nibble each from
+// the lowest (Packer's permutation).
+struct PackOrder {
+  uint32_t v[256];
+  constexpr PackOrder() : v() {
+    for (uint32_t m = 0; m < 256; ++m) {
+      uint32_t packed = 0, k = 0;
+      for (uint32_t i = 0; i < 8; ++i)
+        if ((m >> i) & 1) packed |= i << (4 * k++);
+      v[m] = packed;
+    }
+  }
+};
+inline constexpr PackOrder kPackOrder{};
+#endif
+
+// The lanes picked by a bit mask, packed to the front in lane order and stored as
+// consecutive entries (a compress store): how the shading kernel appends the paths of
+// one kind (going on, shadowed, ...) to its caller's arrays. Only popcount(mask) entries
+// are written, never more: the wavefront appends in place to arrays it is still reading.
+struct Packer {
+#if PB_SIMD_LANES == 16
+  explicit Packer(uint32_t mask) : count(__builtin_popcount(mask)), m(__mmask16(mask)), first(__mmask16((1u << count) - 1)) {}
+  void store(float* p, FV v) const { _mm512_mask_storeu_ps(p, first, _mm512_maskz_compress_ps(m, __m512(v))); }
+  void store(uint32_t* p, UV v) const { _mm512_mask_storeu_epi32(p, first, _mm512_maskz_compress_epi32(m, __m512i(v))); }
+  int count;
+  __mmask16 m, first;
+#else
+  // AVX2 has no compress: a permutation from a table (lane numbers, a nibble each), then
+  // a masked store of the first popcount(mask) lanes.
+  explicit Packer(uint32_t mask)
+      : count(__builtin_popcount(mask)),
+        idx(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int32_t(kPackOrder.v[mask & 0xFF])),
+                                               _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
+                             _mm256_set1_epi32(7))),
+        first(_mm256_cmpgt_epi32(_mm256_set1_epi32(count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7))) {}
+  void store(float* p, FV v) const { _mm256_maskstore_ps(p, first, _mm256_permutevar8x32_ps(__m256(v), idx)); }
+  void store(uint32_t* p, UV v) const {
+    _mm256_maskstore_epi32(reinterpret_cast<int*>(p), first, _mm256_permutevar8x32_epi32(__m256i(v), idx));
+  }
+  int count;
+  __m256i idx, first;
+#endif
+};
+
+// The first n lanes of v to p[0..n) (n <= kLanes; nothing past them is written).
+inline void store_first(float* p, FV v, int n) {
+#if PB_SIMD_LANES == 16
+  _mm512_mask_storeu_ps(p, __mmask16((1u << n) - 1), __m512(v));
+#else
+  _mm256_maskstore_ps(p, _mm256_cmpgt_epi32(_mm256_set1_epi32(n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), __m256(v));
+#endif
 }
 
 #if PB_SIMD_LANES == 16

@@ -90,18 +90,20 @@ inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const Sce
   return TinyScene::build(e, s, size_t(TinyScene::kTrianglesPerLane * k->lanes));
 }
 
-// The closest hits of packet `p` (lanes [0, n) valid; W = k.lanes; tfar already set):
-// the tiny test, and where it leaves any lane unsure, Embree for the whole packet, as
-// the tracer asked before: Embree's own answer for a ray exactly at an edge or at tfar
-// depends on which other lanes are active (packet or single-ray traversal, whose
-// formulas round differently), so only the same call gives the same answer. prim[i]: the
-// scene triangle, or RTC_INVALID_GEOMETRY_ID. Returns the number of unsure lanes.
+// The closest hits of the rays `rays` (six arrays of W: org x, y, z, dir x, y, z; lanes
+// [0, n) valid; W = k.lanes) with packet `p`'s tfar: the tiny test, and where it leaves
+// any lane unsure, Embree for the whole packet (the rays copied into `p` unless they are
+// its own arrays), as the tracer asked before: Embree's own answer for a ray exactly at
+// an edge or at tfar depends on which other lanes are active (packet or single-ray
+// traversal, whose formulas round differently), so only the same call gives the same
+// answer. prim[i]: the scene triangle, or RTC_INVALID_GEOMETRY_ID. Returns the number of
+// unsure lanes (after which the caller resets `p`).
 template <int W>
 int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e, RTCIntersectContext& ctx,
-                 RTCRayHitNt<W>& p, int n, uint32_t* prim) {
-  const float* const rays[6] = {p.ray.org_x, p.ray.org_y, p.ray.org_z, p.ray.dir_x, p.ray.dir_y, p.ray.dir_z};
+                 const float* const* rays, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
   uint32_t unsure = k.tiny_closest(t, rays, p.ray.tfar, prim) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
+  copy_rays<W>(rays, p.ray);
   alignas(64) int valid[W];
   for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
   intersect_packet(valid, e.handle(), &ctx, p);
@@ -110,21 +112,63 @@ int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e
   return __builtin_popcount(unsure);
 }
 
-// Whether each shadow ray of packet `p` (lanes [0, n), tfar set) is blocked: the tiny
-// test, then (as tiny_closest) Embree for the whole packet where it left a lane unsure.
-// Returns the number of unsure lanes.
+// Whether each shadow ray of `rays` (as tiny_closest; tfar: packet `p`'s) is blocked:
+// the tiny test, then (as tiny_closest) Embree for the whole packet where it left a
+// lane unsure. Returns the number of unsure lanes.
 template <int W>
 int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e, RTCIntersectContext& ctx,
-                  RTCRayNt<W>& p, int n, bool* blocked) {
-  const float* const rays[6] = {p.org_x, p.org_y, p.org_z, p.dir_x, p.dir_y, p.dir_z};
+                  const float* const* rays, RTCRayNt<W>& p, int n, bool* blocked) {
   uint32_t unsure = k.tiny_occluded(t, rays, p.tfar, blocked) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
+  copy_rays<W>(rays, p);
   alignas(64) int valid[W];
   for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
   occluded_packet(valid, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i)
     if ((unsure >> i) & 1) blocked[i] = p.tfar[i] < 0.0f;
   return __builtin_popcount(unsure);
+}
+
+// Embree's closest hits for packet p's lanes [0, n) (rays and tfar set), as scene
+// triangles (or RTC_INVALID_GEOMETRY_ID) in prim; p's tfar and geomID reset after.
+template <int W> void embree_closest(const EmbreeScene& e, RTCIntersectContext& ctx, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  intersect_packet(valid, e.handle(), &ctx, p);
+  for (int i = 0; i < n; ++i) prim[i] = packet_triangle(e, p, i);
+  reset_packet(p);
+}
+// Embree's answer whether each of packet p's shadow rays [0, n) is blocked; tfar reset after.
+template <int W> void embree_occluded(const EmbreeScene& e, RTCIntersectContext& ctx, RTCRayNt<W>& p, int n, bool* blocked) {
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  occluded_packet(valid, e.handle(), &ctx, p);
+  for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
+  reset_packet(p);
+}
+
+// The batched strategies' packets, their rays as six arrays (p's own or the caller's,
+// e.g. the shading's streams) and p's tfar / geomID at their start values: the tiny
+// test first where there is one, otherwise Embree (the rays copied into p).
+template <int W>
+void closest_hits(const BatchKernels& k, const TinyScene* tiny, const EmbreeScene& e, RTCIntersectContext& ctx,
+                  const float* const* rays, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
+  if (tiny) {
+    if (tiny_closest<W>(k, *tiny, e, ctx, rays, p, n, prim) > 0) reset_packet(p);
+    return;
+  }
+  copy_rays<W>(rays, p.ray);
+  embree_closest<W>(e, ctx, p, n, prim);
+}
+template <int W>
+void shadows_blocked(const BatchKernels& k, const TinyScene* tiny, const EmbreeScene& e, RTCIntersectContext& ctx,
+                     const float* const* rays, RTCRayNt<W>& p, int n, bool* blocked) {
+  if (tiny) {
+    if (tiny_occluded<W>(k, *tiny, e, ctx, rays, p, n, blocked) > 0) reset_packet(p);
+    return;
+  }
+  copy_rays<W>(rays, p);
+  embree_occluded<W>(e, ctx, p, n, blocked);
 }
 
 }  // namespace pb::cpu

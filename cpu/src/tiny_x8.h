@@ -28,11 +28,9 @@ namespace pb::cpu::PB_SIMD_NS {
 #if PB_SIMD_LANES == 16
 inline FV fmadd(FV a, FV b, FV c) { return FV(_mm512_fmadd_ps(__m512(a), __m512(b), __m512(c))); }
 inline FV fmsub(FV a, FV b, FV c) { return FV(_mm512_fmsub_ps(__m512(a), __m512(b), __m512(c))); }
-inline uint32_t lane_mask(IV m) { return uint32_t(_mm512_movepi32_mask(__m512i(m))); }
 #else
 inline FV fmadd(FV a, FV b, FV c) { return FV(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c))); }
 inline FV fmsub(FV a, FV b, FV c) { return FV(_mm256_fmsub_ps(__m256(a), __m256(b), __m256(c))); }
-inline uint32_t lane_mask(IV m) { return uint32_t(_mm256_movemask_ps(__m256(m))); }
 #endif
 
 // Embree's Vec3 dot and cross (common/math/vec3.h): madd / msub are single FMAs.
@@ -129,7 +127,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     Depth z;
     if constexpr (AnyHit) {
       z = depth();
-      if (lane_mask(~z.away) == 0) continue;  // (movemask: any() tests lane by lane)
+      if (lane_mask(~z.away) == 0) continue;
       ed = edges();
     } else {
       ed = edges();

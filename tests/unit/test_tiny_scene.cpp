@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -152,8 +153,21 @@ double check_rays(const cpu::BatchKernels& k, const cpu::TinyScene& tiny, const 
       unsure_occluded += shadow && ((mo >> i) & 1);
       closest_rays += !shadow;
     }
-    cpu::tiny_closest<W>(k, tiny, embree, ctx, b, W, prim);
-    cpu::tiny_occluded<W>(k, tiny, embree, ctx, sb, W, blocked);
+    // The tracers hand the rays over as arrays of their own (the shading's streams): the
+    // packets' ray arrays are cleared, so Embree sees the rays only as tiny_* copy them.
+    alignas(64) float soa_c[6][W], soa_o[6][W];
+    const float* sc[6];
+    const float* so[6];
+    for (int j = 0; j < 6; ++j) {
+      std::memcpy(soa_c[j], rc[j], sizeof soa_c[j]);
+      std::memcpy(soa_o[j], ro[j], sizeof soa_o[j]);
+      std::memset(const_cast<float*>(rc[j]), 0, sizeof soa_c[j]);
+      std::memset(const_cast<float*>(ro[j]), 0, sizeof soa_o[j]);
+      sc[j] = soa_c[j];
+      so[j] = soa_o[j];
+    }
+    cpu::tiny_closest<W>(k, tiny, embree, ctx, sc, b, W, prim);
+    cpu::tiny_occluded<W>(k, tiny, embree, ctx, so, sb, W, blocked);
     for (int i = 0; i < W; ++i) {
       const uint32_t expect = cpu::packet_triangle(embree, a, i);
       const bool expect_blocked = sa.tfar[i] < 0.0f;
