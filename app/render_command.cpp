@@ -41,6 +41,10 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--embree-layout", o.choices.embree_layout,
                  "CPU: triangles to Embree as they are, paired into quads, or auto (measured per scene)")
       ->capture_default_str();
+  cmd.add_option("--instancing", o.choices.instancing,
+                 "acceleration structure from the scene's instances (CPU: Embree instances, GPU: a two-level BVH): "
+                 "auto (where the scene has instances), on, or off (the flat triangles); same image either way")
+      ->capture_default_str();
   cmd.add_option("--isa", o.choices.isa,
                  "CPU: instruction set of the batched path step: auto (widest the CPU has), avx512, avx2 or scalar; "
                  "same image with each")

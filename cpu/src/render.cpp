@@ -17,8 +17,28 @@ namespace pb::cpu {
 
 uint64_t default_paths_in_flight(int threads) { return uint64_t(threads) * 4096; }
 
+nlohmann::json instancing_report(const Scene& scene, const EmbreeScene& embree, Instancing asked) {
+  const auto& f = embree.instancing();
+  const char* why = embree.instanced() ? "Embree instances of the scene's prototypes"
+                    : scene.instances.empty() ? "the scene has no instances: traced flat"
+                    : asked == Instancing::Off ? "asked off: traced flat"
+                                               : "the quads layout asked for: traced flat";
+  return {{"asked", to_string(asked)},
+          {"used", embree.instanced()},
+          {"why", why},
+          {"scene_instances", scene.instances.size()},
+          {"scene_prototypes", scene.prototypes.size()},
+          {"instances", f.instances},
+          {"prototypes", f.prototypes},
+          {"instances_left_flat", f.instances_left_flat},
+          {"flat_triangles", embree.instanced() ? f.flat_triangles : scene.triangles.size()},
+          {"accel_bytes", embree.bytes()},
+          {"accel_build_seconds", embree.build_seconds()}};
+}
+
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report) {
-  render(scene, *make_embree_scene(scene, settings.watertight, settings.embree_layout), settings, film, report);
+  render(scene, *make_embree_scene(scene, settings.watertight, settings.embree_layout, settings.instancing), settings,
+         film, report);
 }
 
 void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings& settings, Film& film,
@@ -71,6 +91,7 @@ void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings&
                                    {"probe_ns_per_ray", nullptr}};
   if (layout.triangles_ns > 0)
     report.extra["embree_layout"]["probe_ns_per_ray"] = {{"triangles", layout.triangles_ns}, {"quads", layout.quads_ns}};
+  report.extra["instancing"] = instancing_report(scene, embree, settings.instancing);
   // The ISA the path step ran with (scalar where the batched one does not apply:
   // double, other materials, big scenes), the one asked, and what the CPU offers.
   report.extra["isa"] = to_string(totals.isa);

@@ -32,7 +32,8 @@ RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const
     // Built once for every chunk (a million-triangle scene takes Embree a second).
     cpu_ = std::make_unique<Cpu>();
     if (gpu_samples) cpu_->gpu_bvh = std::make_unique<gpu::HostGpuTracer>(scene);
-    else cpu_->scene = cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout);
+    else cpu_->scene = cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout,
+                                                      settings_.instancing);
   } else {
     std::string why;
     if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
