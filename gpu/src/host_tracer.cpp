@@ -12,7 +12,16 @@
 
 namespace pb::gpu {
 
-HostGpuTracer::HostGpuTracer(const Scene& scene) : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env())) {}
+namespace {
+GpuBvhOptions options_for(Instancing instancing) {
+  GpuBvhOptions o = GpuBvhOptions::from_env();
+  o.instancing = instancing;
+  return o;
+}
+}  // namespace
+
+HostGpuTracer::HostGpuTracer(const Scene& scene, Instancing instancing)
+    : scene_(scene), bvh_(build_scene_bvh(scene, options_for(instancing))) {}
 
 void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport& report) const {
   const SceneView view = scene_.view();
@@ -56,6 +65,7 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   report.rays.shadow += shadow;
   report.paths += paths;
   report.discarded_samples += discarded;
+  report.extra["instancing"] = instancing_report(scene_, bvh_, settings.instancing);
   report.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
