@@ -91,8 +91,8 @@ struct RenderChoices {
   std::string sampling = "nee", strategy = "pixel", device = "cpu", precision = "float";
   std::string embree_layout = "auto";
   std::string isa = "auto";  // CPU: instruction set of the batched path step
-  std::string instancing = "auto";
   bool converged = false;  // unbounded paths ended by Russian roulette (max_bounces = -1, rr on)
+  std::string instancing = "auto";
 };
 // Parses the names into `s` and applies `converged`. Throws InputError naming the CLI
 // option (--sampling, ...); the Python module renames those to its keywords. The settings
