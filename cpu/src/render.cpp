@@ -19,21 +19,15 @@ uint64_t default_paths_in_flight(int threads) { return uint64_t(threads) * 4096;
 
 nlohmann::json instancing_report(const Scene& scene, const EmbreeScene& embree, Instancing asked) {
   const auto& f = embree.instancing();
-  const char* why = embree.instanced() ? "Embree instances of the scene's prototypes"
+  const bool used = embree.instanced();
+  const char* why = used                     ? "Embree instances of the scene's prototypes"
                     : scene.instances.empty() ? "the scene has no instances: traced flat"
                     : asked == Instancing::Off ? "asked off: traced flat"
                                                : "the quads layout asked for: traced flat";
-  return {{"asked", to_string(asked)},
-          {"used", embree.instanced()},
-          {"why", why},
-          {"scene_instances", scene.instances.size()},
-          {"scene_prototypes", scene.prototypes.size()},
-          {"instances", f.instances},
-          {"prototypes", f.prototypes},
-          {"instances_left_flat", f.instances_left_flat},
-          {"flat_triangles", embree.instanced() ? f.flat_triangles : scene.triangles.size()},
-          {"accel_bytes", embree.bytes()},
-          {"accel_build_seconds", embree.build_seconds()}};
+  return InstancingSummary{asked, used, why, scene.instances.size(), scene.prototypes.size(), f.instances,
+                           f.prototypes, f.instances_left_flat, used ? f.flat_triangles : scene.triangles.size(),
+                           uint64_t(std::max<int64_t>(0, embree.bytes())), embree.build_seconds()}
+      .to_json();
 }
 
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report) {

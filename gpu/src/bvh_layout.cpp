@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/report.h"
 
 namespace pb::gpu {
 
@@ -32,8 +33,9 @@ GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what) 
   throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute)", what, name));
 }
 
-GpuBvhOptions GpuBvhOptions::from_env() {
+GpuBvhOptions GpuBvhOptions::from_env(Instancing instancing) {
   GpuBvhOptions o;
+  o.instancing = instancing;
   if (const char* v = std::getenv("PATHBENCH_GPU_BVH"); v && *v) o.layout = parse_gpu_bvh_layout(v);
   if (const char* v = std::getenv("PATHBENCH_GPU_BRUTE_MAX_TRIS"); v && *v) {
     const std::string_view s(v);
@@ -129,17 +131,10 @@ nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, In
   const char* why = used                     ? "a two-level BVH over the scene's instances"
                     : scene.instances.empty() ? "the scene has no instances: traced flat"
                                               : "asked off: traced flat";
-  return {{"asked", to_string(asked)},
-          {"used", used},
-          {"why", why},
-          {"scene_instances", scene.instances.size()},
-          {"scene_prototypes", scene.prototypes.size()},
-          {"instances", t.instanced},
-          {"prototypes", t.prototypes},
-          {"instances_left_flat", t.instances_left_flat},
-          {"flat_triangles", used ? t.flat_triangles : scene.triangles.size()},
-          {"accel_bytes", bvh.bytes()},
-          {"accel_build_seconds", bvh.build_seconds}};
+  return InstancingSummary{asked, used, why, scene.instances.size(), scene.prototypes.size(), t.instanced,
+                           t.prototypes, t.instances_left_flat, used ? t.flat_triangles : scene.triangles.size(),
+                           bvh.bytes(), bvh.build_seconds}
+      .to_json();
 }
 
 }  // namespace pb::gpu

@@ -12,16 +12,8 @@
 
 namespace pb::gpu {
 
-namespace {
-GpuBvhOptions options_for(Instancing instancing) {
-  GpuBvhOptions o = GpuBvhOptions::from_env();
-  o.instancing = instancing;
-  return o;
-}
-}  // namespace
-
 HostGpuTracer::HostGpuTracer(const Scene& scene, Instancing instancing)
-    : scene_(scene), bvh_(build_scene_bvh(scene, options_for(instancing))) {}
+    : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env(instancing))) {}
 
 void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport& report) const {
   const SceneView view = scene_.view();

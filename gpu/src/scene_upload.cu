@@ -11,15 +11,8 @@ namespace pb::gpu {
 
 GpuScene::GpuScene(const Scene& scene) : GpuScene(scene, GpuBvhOptions::from_env()) {}
 
-namespace {
-GpuBvhOptions with_instancing(Instancing instancing) {
-  GpuBvhOptions o = GpuBvhOptions::from_env();
-  o.instancing = instancing;
-  return o;
-}
-}  // namespace
-
-GpuScene::GpuScene(const Scene& scene, Instancing instancing) : GpuScene(scene, with_instancing(instancing)) {}
+GpuScene::GpuScene(const Scene& scene, Instancing instancing)
+    : GpuScene(scene, GpuBvhOptions::from_env(instancing)) {}
 
 GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std::make_unique<Impl>()) {
   ensure_device();

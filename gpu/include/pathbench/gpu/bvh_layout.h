@@ -39,11 +39,11 @@ struct GpuBvhOptions {
   GpuBvhLayout layout = GpuBvhLayout::Auto;
   uint32_t brute_max_triangles = kDefaultBruteMaxTriangles;  // auto: brute force up to this many
   // The render's --instancing: where use_instancing() says so, the two-level BVH
-  // whatever `layout` says (from_env leaves it Off; the tracers set it from the settings).
+  // whatever `layout` says.
   Instancing instancing = Instancing::Off;
-  // From PATHBENCH_GPU_BVH and PATHBENCH_GPU_BRUTE_MAX_TRIS where set; throws InputError
-  // naming the variable for a value it cannot use.
-  static GpuBvhOptions from_env();
+  // From PATHBENCH_GPU_BVH and PATHBENCH_GPU_BRUTE_MAX_TRIS where set, with the render's
+  // --instancing; throws InputError naming the variable for a value it cannot use.
+  static GpuBvhOptions from_env(Instancing instancing = Instancing::Off);
 };
 
 const char* to_string(GpuBvhLayout l);
