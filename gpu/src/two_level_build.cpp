@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 
 namespace pb::gpu {
 
@@ -17,12 +16,12 @@ struct Inverse {
   double m[3][4];
 };
 
-// The inverse of the affine `a`, in double.
-Inverse invert(const Affine& a) {
+// The inverse of the affine `a`, in double; false where it has none (a copy flattened to
+// zero area has lost its triangles to finalize() anyway, and stays flat).
+bool invert(const Affine& a, Inverse& r) {
   const auto& m = a.m;
   const double det = a.determinant();
-  if (!(std::fabs(det) > 0) || !std::isfinite(det)) throw std::invalid_argument("two-level BVH: a singular instance transform");
-  Inverse r;
+  if (!(std::fabs(det) > 0) || !std::isfinite(det)) return false;
   r.m[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
   r.m[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
   r.m[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
@@ -33,7 +32,7 @@ Inverse invert(const Affine& a) {
   r.m[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
   r.m[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
   for (int i = 0; i < 3; ++i) r.m[i][3] = -(r.m[i][0] * m[0][3] + r.m[i][1] * m[1][3] + r.m[i][2] * m[2][3]);
-  return r;
+  return true;
 }
 
 Vec3d apply(const Inverse& r, const Vec3f& p) {
@@ -86,13 +85,13 @@ TwoLevelHost build_two_level_bvh(const Scene& s, const BvhBuildOptions& options)
   for (uint32_t i = 0; i < s.instances.size(); ++i) {
     const SceneInstance& in = s.instances[i];
     const ScenePrototype& p = s.prototypes.at(in.prototype);
-    if (in.triangle_count != p.triangles.size() || p.triangles.empty()) {
+    // Traced coordinates are the user's less Scene::origin (scene_origin.cpp).
+    const Affine m = Affine::translate(-double(s.origin.x), -double(s.origin.y), -double(s.origin.z)) * in.to_world;
+    Inverse inv;
+    if (in.triangle_count != p.triangles.size() || p.triangles.empty() || !invert(m, inv)) {
       ++out.instances_left_flat;
       continue;
     }
-    // Traced coordinates are the user's less Scene::origin (scene_origin.cpp).
-    const Affine m = Affine::translate(-double(s.origin.x), -double(s.origin.y), -double(s.origin.z)) * in.to_world;
-    const Inverse inv = invert(m);
     // The flat triangles were rounded (to float, maybe rebased or rescaled) on their way
     // from the prototype: measure how far they lie from it, in its coordinates...
     double dev = 0;

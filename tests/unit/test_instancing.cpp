@@ -17,6 +17,8 @@
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/isa.h"
+#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/gpu/host_tracer.h"
 #include "pathbench/run/run.h"
 
 namespace pb {
@@ -67,6 +69,72 @@ TEST(Instancing, WhereItCannotApply) {
   const run::Rendered r = run::render(load_scene("paper-cornell"), s);
   EXPECT_EQ(r.report.extra["instancing"]["used"], false);
   EXPECT_EQ(r.report.extra["instancing"]["why"], "the scene has no instances: traced flat");
+}
+
+// A copy that lost a triangle to finalize() (zero area where it was placed) cannot be an
+// instance of its prototype: both devices trace it flat, and the films still match.
+TEST(Instancing, CopiesThatLostTrianglesStayFlat) {
+  Scene s;
+  s.name = "lost-triangle";
+  s.materials = {Material{{0.7f, 0.7f, 0.7f}, {0, 0, 0}}, Material{{0, 0, 0}, {5, 5, 5}}};
+  ScenePrototype p{"quad", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{{0, 1, 2}}, {{0, 2, 3}}}, {0, 0}};
+  s.prototypes.push_back(p);
+  auto place = [&](float dx, bool squash) {
+    const uint32_t base = uint32_t(s.positions.size()), first = uint32_t(s.triangles.size());
+    for (Vec3f v : p.positions) s.positions.push_back({v.x + dx, squash ? 0.0f : v.y, 0});
+    for (const Triangle& t : p.triangles) {
+      s.triangles.push_back({{base + t.v[0], base + t.v[1], base + t.v[2]}});
+      s.material_ids.push_back(0);
+    }
+    // The squashed copy's to_world is singular: its triangles have no area.
+    Affine m = Affine::translate(dx, 0, 0);
+    if (squash) m = m * Affine::scale(1, 0, 1);
+    s.instances.push_back({0, m, first, 2});
+  };
+  place(-1.5f, false);
+  place(0.0f, true);
+  place(1.5f, false);
+  const uint32_t base = uint32_t(s.positions.size());  // a light above, facing down
+  for (Vec3f v : {Vec3f{-1, 3, -1}, Vec3f{1, 3, -1}, Vec3f{1, 3, 1}, Vec3f{-1, 3, 1}}) s.positions.push_back(v);
+  s.triangles.push_back({{base, base + 1, base + 2}});
+  s.triangles.push_back({{base, base + 2, base + 3}});
+  s.material_ids.insert(s.material_ids.end(), {1, 1});
+  s.camera = Camera::look_at({0, 0.5f, 4}, {0, 0.5f, 0}, {0, 1, 0}, 50);
+  testing::internal::CaptureStderr();
+  s.finalize();  // drops the squashed copy's two triangles
+  testing::internal::GetCapturedStderr();
+  ASSERT_EQ(s.instances[1].triangle_count, 0u);
+  ASSERT_EQ(s.instances[2].first_triangle, 2u);
+
+  const auto embree = cpu::make_embree_scene(s, true, EmbreeLayout::Triangles, Instancing::On);
+  EXPECT_EQ(embree->instancing().instances, 2u);
+  EXPECT_EQ(embree->instancing().instances_left_flat, 1u);
+  gpu::GpuBvhOptions o;
+  o.instancing = Instancing::On;
+  const gpu::SceneBvhHost two = gpu::build_scene_bvh(s, o);
+  EXPECT_EQ(two.two_level.instanced, 2u);
+  EXPECT_EQ(two.two_level.instances_left_flat, 1u);
+
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  rs.spp = 4;
+  rs.progress = false;
+  rs.instancing = Instancing::Off;
+  const run::Rendered flat = run::render(s, rs);
+  double lit = 0;
+  for (float v : flat.film.mean()) lit += v;
+  EXPECT_GT(lit, 1.0);  // the two kept copies are seen, lit
+  rs.instancing = Instancing::On;
+  EXPECT_EQ(run::render(s, rs).film.raw_sums(), flat.film.raw_sums());
+  Film a(rs.width, rs.height, false), b(rs.width, rs.height, false);
+  a.begin(rs.spp, s.max_emission());
+  b.begin(rs.spp, s.max_emission());
+  RunReport ra, rb;
+  gpu::HostGpuTracer(s, Instancing::Off).render(rs, a, ra);
+  gpu::HostGpuTracer(s, Instancing::On).render(rs, b, rb);
+  EXPECT_EQ(a.raw_sums(), b.raw_sums());
+  EXPECT_EQ(rb.extra["instancing"]["instances_left_flat"], 1);
 }
 
 TEST(Instancing, InstancedFilmsEqualFlat) {
