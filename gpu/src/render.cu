@@ -169,8 +169,9 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
               {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth},
               {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
               {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
-                          : g.layout == GpuBvhLayout::Binary
-                              ? "embree rtcBuildBVH, binned SAH, binary"
+                          : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"
+                          : g.layout == GpuBvhLayout::TwoLevel
+                              ? "embree rtcBuildBVH, binned SAH, binary: over the instances, and one per prototype"
                               : "embree rtcBuildBVH, binned SAH, binary (leaves <= 3), collapsed greedily"}};
   x["instancing"] = g.instancing;
   x["device_samples_per_second"] = device_ms > 0 ? double(r.stats.paths) / (device_ms / 1e3) : 0.0;

@@ -62,6 +62,10 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh_tris = uint32_t(m.tris.size());
   m.bvh_depth = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_depth : bvh.wide.depth;
   m.bvh_leaves = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_leaves : bvh.wide.leaves;
+  if (bvh.layout == GpuBvhLayout::TwoLevel) {  // the deepest top-to-triangle path; triangle references
+    m.bvh_depth = two.top_depth + two.bottom_depth;
+    m.bvh_tris = uint32_t(two.bottom_items.size());
+  }
   m.bvh_sah = bvh.binary_sah;
   m.bvh_build_seconds = bvh.build_seconds;
 }
