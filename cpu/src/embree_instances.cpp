@@ -2,12 +2,15 @@
 // for the acceleration structure only. Each prototype is one Embree scene in its own
 // coordinates, each SceneInstance an RTC_GEOMETRY_TYPE_INSTANCE of it, and the
 // triangles no instance covers (walls, lights, instances that lost triangles to
-// finalize()) one ordinary triangle geometry. Embree then names a triangle; the path
-// step recomputes the hit on the flat, world-space triangle (surface_hit), so shading
+// finalize(), copies rounded far from their prototype's image: exact_copy) one ordinary
+// triangle geometry. Embree then names a triangle; the path step recomputes the hit on
+// the flat, world-space triangle (surface_hit), so shading
 // sees exactly the flat scene's triangles. Whether Embree names the same triangle as
 // in the flat scene is tested, not assumed (tests/unit/test_instancing.cpp, cpu/NOTES.md).
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <unordered_map>
@@ -34,17 +37,32 @@ void attach_triangles(RTCDevice device, RTCScene scene, const std::vector<Vec3f>
   rtcReleaseGeometry(g);
 }
 
+// Whether the instance's flat triangles are its prototype's image under its transform up
+// to the rounding of that one expansion (half an ulp; a few ulps allowed). Not so where the
+// scene was rebased far from the origin or rescaled after loading: the flat copy was
+// rounded at the user's coordinates, and Embree's instance (the prototype, transformed
+// exactly) would be another surface, a thousandth of the scene off at 3e5 from the origin.
+// Such copies stay flat.
+bool exact_copy(const Scene& s, const SceneInstance& in) {
+  float largest = 0;
+  for (uint32_t k = 0; k < in.triangle_count; ++k)
+    for (uint32_t v : s.triangles[in.first_triangle + k].v)
+      largest = std::max({largest, std::fabs(s.positions[v].x), std::fabs(s.positions[v].y), std::fabs(s.positions[v].z)});
+  return instance_deviation(s, in) <= std::ldexp(double(largest), -22);
+}
+
 }  // namespace
 
 void EmbreeScene::build_instanced(const Scene& s, bool watertight) {
   // An instance is traced as an instance only where it kept every prototype triangle
-  // (then its flat triangles are first_triangle + the prototype's primitive ids).
+  // (then its flat triangles are first_triangle + the prototype's primitive ids) and its
+  // flat copy is the prototype's image (exact_copy).
   std::vector<char> covered(s.triangles.size(), 0);
   std::vector<RTCScene> proto_scene(s.prototypes.size(), nullptr);
   unsigned id = 0;
   for (const SceneInstance& in : s.instances) {
     const ScenePrototype& p = s.prototypes.at(in.prototype);
-    if (in.triangle_count != p.triangles.size() || p.triangles.empty()) {
+    if (in.triangle_count != p.triangles.size() || p.triangles.empty() || !exact_copy(s, in)) {
       ++facts_.instances_left_flat;
       continue;
     }
@@ -57,9 +75,7 @@ void EmbreeScene::build_instanced(const Scene& s, bool watertight) {
       rtcCommitScene(ps);
       prototypes_.push_back(ps);
     }
-    // The traced coordinates are the user's less Scene::origin (scene_origin.cpp), which
-    // the flat positions went through and the instance's to_world did not.
-    const Affine m = Affine::translate(-double(s.origin.x), -double(s.origin.y), -double(s.origin.z)) * in.to_world;
+    const Affine m = traced_to_world(s, in);
     float xfm[12];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) xfm[4 * r + c] = float(m.m[r][c]);

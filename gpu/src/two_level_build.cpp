@@ -35,12 +35,6 @@ bool invert(const Affine& a, Inverse& r) {
   return true;
 }
 
-Vec3d apply(const Inverse& r, const Vec3f& p) {
-  double o[3];
-  for (int i = 0; i < 3; ++i) o[i] = r.m[i][0] * p.x + r.m[i][1] * p.y + r.m[i][2] * p.z + r.m[i][3];
-  return {o[0], o[1], o[2]};
-}
-
 double max_abs(const Vec3f& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
 
 // Grows every (non-empty) child box of `nodes` by `pad` on each side.
@@ -85,33 +79,22 @@ TwoLevelHost build_two_level_bvh(const Scene& s, const BvhBuildOptions& options)
   for (uint32_t i = 0; i < s.instances.size(); ++i) {
     const SceneInstance& in = s.instances[i];
     const ScenePrototype& p = s.prototypes.at(in.prototype);
-    // Traced coordinates are the user's less Scene::origin (scene_origin.cpp).
-    const Affine m = Affine::translate(-double(s.origin.x), -double(s.origin.y), -double(s.origin.z)) * in.to_world;
+    const Affine m = traced_to_world(s, in);
     Inverse inv;
     if (in.triangle_count != p.triangles.size() || p.triangles.empty() || !invert(m, inv)) {
       ++out.instances_left_flat;
       continue;
     }
     // The flat triangles were rounded (to float, maybe rebased or rescaled) on their way
-    // from the prototype: measure how far they lie from it, in its coordinates...
-    double dev = 0;
-    for (uint32_t k = 0; k < in.triangle_count; ++k) {
-      const Triangle& ft = s.triangles[in.first_triangle + k];
-      const Triangle& pt = p.triangles[k];
-      for (uint32_t fv : ft.v) {
-        const Vec3d q = apply(inv, s.positions[fv]);
-        double nearest = INFINITY;  // the matching vertex (a mirrored copy's winding is flipped)
-        for (uint32_t pv : pt.v) nearest = std::min(nearest, max_component(vabs(q - Vec3d(p.positions[pv]))));
-        dev = std::max(dev, nearest);
-      }
-    }
-    // ...and add the rounding of a ray's transform (float matrix, three products and sums:
-    // far below 2^-16 of the largest term).
+    // from the prototype: how far they lie from it, taken into its coordinates, plus the
+    // rounding of a ray's transform (float matrix, three products and sums: far below
+    // 2^-16 of the largest term).
     double norm = 0, shift = 0;
     for (int r = 0; r < 3; ++r) {
       norm = std::max(norm, std::fabs(inv.m[r][0]) + std::fabs(inv.m[r][1]) + std::fabs(inv.m[r][2]));
       shift = std::max(shift, std::fabs(inv.m[r][3]));
     }
+    const double dev = norm * instance_deviation(s, in);
     const double pad = dev + std::ldexp(norm * reach + shift, -16);
     proto_pad[in.prototype] = std::max(proto_pad[in.prototype], pad);
     used.emplace_back(i, inv);

@@ -71,41 +71,80 @@ TEST(Instancing, WhereItCannotApply) {
   EXPECT_EQ(r.report.extra["instancing"]["why"], "the scene has no instances: traced flat");
 }
 
-// A copy that lost a triangle to finalize() (zero area where it was placed) cannot be an
-// instance of its prototype: both devices trace it flat, and the films still match.
-TEST(Instancing, CopiesThatLostTrianglesStayFlat) {
+// Three copies of a unit quad in a row at x0 + (-1.5, 0, 1.5) under a light; with
+// `squash`, the middle copy's transform flattens it (its triangles have no area, and
+// finalize() drops them). Every coordinate is a small dyadic number plus x0: at x0 = 3e5
+// the flat copies are still the exact images of the prototype, and the scene is rebased.
+Scene quad_copies(float x0, bool squash) {
   Scene s;
-  s.name = "lost-triangle";
+  s.name = "quad-copies";
   s.materials = {Material{{0.7f, 0.7f, 0.7f}, {0, 0, 0}}, Material{{0, 0, 0}, {5, 5, 5}}};
-  ScenePrototype p{"quad", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{{0, 1, 2}}, {{0, 2, 3}}}, {0, 0}};
+  const ScenePrototype p{"quad", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{{0, 1, 2}}, {{0, 2, 3}}}, {0, 0}};
   s.prototypes.push_back(p);
-  auto place = [&](float dx, bool squash) {
+  for (float dx : {-1.5f, 0.0f, 1.5f}) {
+    const bool flatten = squash && dx == 0.0f;
+    Affine m = Affine::translate(x0 + dx, 0, 0);
+    if (flatten) m = m * Affine::scale(1, 0, 1);
     const uint32_t base = uint32_t(s.positions.size()), first = uint32_t(s.triangles.size());
-    for (Vec3f v : p.positions) s.positions.push_back({v.x + dx, squash ? 0.0f : v.y, 0});
+    for (Vec3f v : p.positions) s.positions.push_back(m.point(v));
     for (const Triangle& t : p.triangles) {
       s.triangles.push_back({{base + t.v[0], base + t.v[1], base + t.v[2]}});
       s.material_ids.push_back(0);
     }
-    // The squashed copy's to_world is singular: its triangles have no area.
-    Affine m = Affine::translate(dx, 0, 0);
-    if (squash) m = m * Affine::scale(1, 0, 1);
     s.instances.push_back({0, m, first, 2});
-  };
-  place(-1.5f, false);
-  place(0.0f, true);
-  place(1.5f, false);
+  }
   const uint32_t base = uint32_t(s.positions.size());  // a light above, facing down
-  for (Vec3f v : {Vec3f{-1, 3, -1}, Vec3f{1, 3, -1}, Vec3f{1, 3, 1}, Vec3f{-1, 3, 1}}) s.positions.push_back(v);
+  for (Vec3f v : {Vec3f{-1, 3, -1}, Vec3f{1, 3, -1}, Vec3f{1, 3, 1}, Vec3f{-1, 3, 1}})
+    s.positions.push_back(v + Vec3f{x0, 0, 0});
   s.triangles.push_back({{base, base + 1, base + 2}});
   s.triangles.push_back({{base, base + 2, base + 3}});
   s.material_ids.insert(s.material_ids.end(), {1, 1});
-  s.camera = Camera::look_at({0, 0.5f, 4}, {0, 0.5f, 0}, {0, 1, 0}, 50);
+  s.camera = Camera::look_at({x0, 0.5f, 4}, {x0, 0.5f, 0}, {0, 1, 0}, 50);
   testing::internal::CaptureStderr();
-  s.finalize();  // drops the squashed copy's two triangles
+  s.finalize();
   testing::internal::GetCapturedStderr();
+  return s;
+}
+
+// The CPU's and the GPU's (HostGpuTracer) films of `s`, instanced and flat, are equal,
+// and lit; returns the CPU's instanced report. The CPU renders with the scalar path step
+// too: for a scene this small the vector one asks Embree only where its own test of every
+// triangle is unsure (cpu/src/tiny_scene.h).
+RunReport expect_films_equal_flat(const Scene& s) {
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  rs.spp = 4;
+  rs.progress = false;
+  run::Rendered inst;
+  for (Isa isa : {Isa::Scalar, Isa::Auto}) {
+    rs.isa = isa;
+    rs.instancing = Instancing::Off;
+    const run::Rendered flat = run::render(s, rs);
+    double lit = 0;
+    for (float v : flat.film.mean()) lit += v;
+    EXPECT_GT(lit, 1.0);
+    rs.instancing = Instancing::On;
+    inst = run::render(s, rs);
+    EXPECT_EQ(inst.film.raw_sums(), flat.film.raw_sums()) << to_string(isa);
+  }
+  Film a(rs.width, rs.height, false), b(rs.width, rs.height, false);
+  a.begin(rs.spp, s.max_emission());
+  b.begin(rs.spp, s.max_emission());
+  RunReport ra, rb;
+  gpu::HostGpuTracer(s, Instancing::Off).render(rs, a, ra);
+  gpu::HostGpuTracer(s, Instancing::On).render(rs, b, rb);
+  EXPECT_EQ(a.raw_sums(), b.raw_sums());
+  EXPECT_EQ(rb.extra["instancing"]["used"], true);
+  return inst.report;
+}
+
+// A copy that lost its triangles to finalize() cannot be an instance of its prototype:
+// both devices trace it flat, and the films still match.
+TEST(Instancing, CopiesThatLostTrianglesStayFlat) {
+  const Scene s = quad_copies(0, true);
   ASSERT_EQ(s.instances[1].triangle_count, 0u);
   ASSERT_EQ(s.instances[2].first_triangle, 2u);
-
   const auto embree = cpu::make_embree_scene(s, true, EmbreeLayout::Triangles, Instancing::On);
   EXPECT_EQ(embree->instancing().instances, 2u);
   EXPECT_EQ(embree->instancing().instances_left_flat, 1u);
@@ -114,27 +153,28 @@ TEST(Instancing, CopiesThatLostTrianglesStayFlat) {
   const gpu::SceneBvhHost two = gpu::build_scene_bvh(s, o);
   EXPECT_EQ(two.two_level.instanced, 2u);
   EXPECT_EQ(two.two_level.instances_left_flat, 1u);
+  expect_films_equal_flat(s);
+}
 
-  RenderSettings rs;
-  rs.width = 32;
-  rs.height = 24;
-  rs.spp = 4;
-  rs.progress = false;
-  rs.instancing = Instancing::Off;
-  const run::Rendered flat = run::render(s, rs);
-  double lit = 0;
-  for (float v : flat.film.mean()) lit += v;
-  EXPECT_GT(lit, 1.0);  // the two kept copies are seen, lit
-  rs.instancing = Instancing::On;
-  EXPECT_EQ(run::render(s, rs).film.raw_sums(), flat.film.raw_sums());
-  Film a(rs.width, rs.height, false), b(rs.width, rs.height, false);
-  a.begin(rs.spp, s.max_emission());
-  b.begin(rs.spp, s.max_emission());
-  RunReport ra, rb;
-  gpu::HostGpuTracer(s, Instancing::Off).render(rs, a, ra);
-  gpu::HostGpuTracer(s, Instancing::On).render(rs, b, rb);
-  EXPECT_EQ(a.raw_sums(), b.raw_sums());
-  EXPECT_EQ(rb.extra["instancing"]["instances_left_flat"], 1);
+// Far from the origin the scene is rebased (scene_origin.cpp) but the instances' to_world
+// are not: the instances must follow Scene::origin, or every copy would be missed.
+TEST(Instancing, FollowsARebasedScene) {
+  const Scene s = quad_copies(3e5f, false);
+  ASSERT_GT(s.origin.x, 1e5f);  // rebased
+  const RunReport r = expect_films_equal_flat(s);
+  EXPECT_EQ(r.extra["instancing"]["instances"], 3);
+}
+
+// A scene moved far away after loading: its copies were rounded at 3e5 (steps of 0.03),
+// so they are no longer the prototype's images. The CPU traces them flat (Embree's
+// instance would be another surface); the GPU keeps them instanced (it tests the flat
+// triangles, its boxes padded by the difference). Both match the flat films.
+TEST(Instancing, CopiesRoundedFarAwayStayFlatOnTheCpu) {
+  const Scene s = transformed(quiet_load("scenes/examples/instancing.json"), 1.0f, {3e5f, 0, -2e5f});
+  ASSERT_NE(s.origin.x, 0.0f);
+  const RunReport r = expect_films_equal_flat(s);
+  EXPECT_EQ(r.extra["instancing"]["instances"], 0);
+  EXPECT_EQ(r.extra["instancing"]["instances_left_flat"], 8);
 }
 
 TEST(Instancing, InstancedFilmsEqualFlat) {
