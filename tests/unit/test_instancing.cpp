@@ -210,6 +210,7 @@ TEST(Instancing, InstancedFilmsEqualFlat) {
           EXPECT_EQ(inst.film.raw_sums(), flat.film.raw_sums());
           EXPECT_EQ(inst.report.rays.total(), flat.report.rays.total());
           EXPECT_EQ(inst.report.extra["instancing"]["used"], true);
+          EXPECT_EQ(inst.report.extra["instancing"]["instances"], scene.instances.size());  // none left flat
           EXPECT_EQ(inst.report.extra["embree_layout"]["used"], "triangles");
         }
   }
