@@ -41,6 +41,11 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--embree-layout", o.choices.embree_layout,
                  "CPU: triangles to Embree as they are, paired into quads, or auto (measured per scene)")
       ->capture_default_str();
+  cmd.add_option("--instancing", o.choices.instancing,
+                 "acceleration structure from the scene's instances (CPU: Embree instances, GPU: a two-level BVH): "
+                 "auto (where the scene has instances), on, or off (the flat triangles); the GPU's image is the flat one "
+                 "bit for bit, the CPU's but for rare rays meeting a copy's edge (cpu/NOTES.md)")
+      ->capture_default_str();
   cmd.add_option("--isa", o.choices.isa,
                  "CPU: instruction set of the batched path step: auto (widest the CPU has), avx512, avx2 or scalar; "
                  "same image with each")
@@ -123,6 +128,9 @@ ImageMetadata image_metadata(const RunReport& report) {
   for (const char* key : {"width", "height", "spp", "bounces", "russian_roulette", "sampling", "watertight", "precision",
                           "device", "strategy", "seed"})
     if (j.contains(key)) settings[key] = j[key];
+  // Instanced or not: on the CPU it can change rare pixels (cpu/NOTES.md).
+  settings["instancing"] = to_string(report.settings.instancing);
+  if (j.contains("instancing")) settings["instanced"] = j["instancing"].value("used", false);
   return {{"Software", fmt::format("pathbench {}", version_number())},
           {"pathbench:scene", report.scene},
           {"pathbench:spp", std::to_string(report.settings.spp)},

@@ -50,6 +50,20 @@ nlohmann::json RunReport::to_json() const {
   return j;
 }
 
+nlohmann::json InstancingSummary::to_json() const {
+  return {{"asked", to_string(asked)},
+          {"used", used},
+          {"why", why},
+          {"scene_instances", scene_instances},
+          {"scene_prototypes", scene_prototypes},
+          {"instances", instances},
+          {"prototypes", prototypes},
+          {"instances_left_flat", instances_left_flat},
+          {"flat_triangles", flat_triangles},
+          {"accel_bytes", accel_bytes},
+          {"accel_build_seconds", accel_build_seconds}};
+}
+
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
   std::string line;

@@ -44,6 +44,15 @@ const char* to_string(Isa i) {
   return "?";
 }
 
+const char* to_string(Instancing i) {
+  switch (i) {
+    case Instancing::Auto: return "auto";
+    case Instancing::On: return "on";
+    case Instancing::Off: return "off";
+  }
+  return "?";
+}
+
 Sampling parse_sampling(std::string_view s) {
   if (s == "uniform") return Sampling::Uniform;
   if (s == "cosine") return Sampling::Cosine;
@@ -82,6 +91,13 @@ Isa parse_isa(std::string_view s) {
   throw InputError(fmt::format("--isa: unknown instruction set '{}' (expected auto, avx512, avx2 or scalar)", s));
 }
 
+Instancing parse_instancing(std::string_view s) {
+  if (s == "auto") return Instancing::Auto;
+  if (s == "on") return Instancing::On;
+  if (s == "off") return Instancing::Off;
+  throw InputError(fmt::format("--instancing: unknown choice '{}' (expected auto, on or off)", s));
+}
+
 void apply_choices(const RenderChoices& c, RenderSettings& s) {
   s.sampling = parse_sampling(c.sampling);
   s.strategy = parse_strategy(c.strategy);
@@ -89,6 +105,7 @@ void apply_choices(const RenderChoices& c, RenderSettings& s) {
   s.precision = parse_precision(c.precision);
   s.embree_layout = parse_embree_layout(c.embree_layout);
   s.isa = parse_isa(c.isa);
+  s.instancing = parse_instancing(c.instancing);
   if (c.converged) {
     s.max_bounces = -1;
     s.russian_roulette = true;

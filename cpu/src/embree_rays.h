@@ -97,7 +97,7 @@ template <int W> void reset_packet(RTCRayNt<W>& p) {
 // The scene triangle a packet's lane i hit (after intersect_packet), or RTC_INVALID_GEOMETRY_ID.
 template <int W> inline uint32_t packet_triangle(const EmbreeScene& e, const RTCRayHitNt<W>& p, int i) {
   return p.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID ? RTC_INVALID_GEOMETRY_ID
-                                                    : e.triangle(p.hit.primID[i], p.hit.u[i], p.hit.v[i]);
+                                                    : e.triangle(p.hit.instID[0][i], p.hit.primID[i], p.hit.u[i], p.hit.v[i]);
 }
 
 // Rays kept as six arrays (org x, y, z, dir x, y, z: the shading kernel's streams,

@@ -1,9 +1,11 @@
 #include "pathbench/cpu/embree_scene.h"
 
+#include "pathbench/common/errors.h"
 #include "pathbench/cpu/embree_flags.h"
 
 #include <fmt/core.h>
 
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
@@ -25,7 +27,14 @@ bool EmbreeScene::monitor(void* self_ptr, ssize_t bytes, bool) {
   return true;
 }
 
-std::unique_ptr<EmbreeScene> make_embree_scene(const Scene& s, bool watertight, EmbreeLayout layout) {
+std::unique_ptr<EmbreeScene> make_embree_scene(const Scene& s, bool watertight, EmbreeLayout layout,
+                                               Instancing instancing) {
+  if (use_instancing(instancing, s.instances.size())) {
+    if (layout == EmbreeLayout::Quads && instancing == Instancing::On)
+      throw InputError("--instancing on: the instanced Embree scene is built from triangles; it cannot be "
+                       "combined with --embree-layout quads (give one of them)");
+    if (layout != EmbreeLayout::Quads) return std::make_unique<EmbreeScene>(s, watertight, EmbreeScene::Instanced{});
+  }
   TrianglePairs pairs;
   const LayoutChoice choice = layout == EmbreeLayout::Auto ? choose_embree_layout(s, watertight, &pairs)
                                                            : LayoutChoice{layout, 0, 0.0, 0.0, "asked for"};
@@ -40,13 +49,8 @@ EmbreeScene::EmbreeScene(const Scene& s, bool watertight, const LayoutChoice& ch
   if (choice_.layout == EmbreeLayout::Auto) throw std::logic_error("EmbreeScene: resolve Auto first (make_embree_scene)");
   if (quads_ && pairs_.quads.empty() && !s.triangles.empty())
     throw std::logic_error("EmbreeScene: the quads layout needs the triangle pairs");
-  device_ = rtcNewDevice(nullptr);
-  if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
-  rtcSetDeviceErrorFunction(device_, on_error, nullptr);
-  rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeScene::monitor, this);
-  scene_ = rtcNewScene(device_);
-  rtcSetSceneFlags(scene_, embree_scene_flags(watertight));
-  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  const auto t0 = std::chrono::steady_clock::now();
+  open_device(watertight);
   RTCGeometry geom = rtcNewGeometry(device_, quads_ ? RTC_GEOMETRY_TYPE_QUAD : RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                         3 * sizeof(float), s.positions.size()));
@@ -63,6 +67,31 @@ EmbreeScene::EmbreeScene(const Scene& s, bool watertight, const LayoutChoice& ch
   rtcCommitGeometry(geom);
   rtcAttachGeometry(scene_, geom);
   rtcReleaseGeometry(geom);
+  commit();
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+EmbreeScene::EmbreeScene(const Scene& s, bool watertight, Instanced)
+    : choice_{EmbreeLayout::Triangles, 0, 0.0, 0.0, "instancing (prototypes and the rest as triangles)"},
+      instanced_(true) {
+  const auto t0 = std::chrono::steady_clock::now();
+  open_device(watertight);
+  build_instanced(s, watertight);
+  commit();
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void EmbreeScene::open_device(bool watertight) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error(fmt::format("embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
+  rtcSetDeviceErrorFunction(device_, on_error, nullptr);
+  rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeScene::monitor, this);
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneFlags(scene_, embree_scene_flags(watertight));
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+}
+
+void EmbreeScene::commit() {
   rtcCommitScene(scene_);
   if (RTCError e = rtcGetDeviceError(device_); e != RTC_ERROR_NONE)
     throw std::runtime_error(fmt::format("embree: building the scene failed (error {})", int(e)));
@@ -70,6 +99,7 @@ EmbreeScene::EmbreeScene(const Scene& s, bool watertight, const LayoutChoice& ch
 
 EmbreeScene::~EmbreeScene() {
   if (scene_) rtcReleaseScene(scene_);
+  for (RTCScene p : prototypes_) rtcReleaseScene(p);
   if (device_) rtcReleaseDevice(device_);
 }
 

@@ -17,8 +17,22 @@ namespace pb::cpu {
 
 uint64_t default_paths_in_flight(int threads) { return uint64_t(threads) * 4096; }
 
+nlohmann::json instancing_report(const Scene& scene, const EmbreeScene& embree, Instancing asked) {
+  const auto& f = embree.instancing();
+  const bool used = embree.instanced();
+  const char* why = used                     ? "Embree instances of the scene's prototypes"
+                    : scene.instances.empty() ? "the scene has no instances: traced flat"
+                    : asked == Instancing::Off ? "asked off: traced flat"
+                                               : "the quads layout asked for: traced flat";
+  return InstancingSummary{asked, used, why, scene.instances.size(), scene.prototypes.size(), f.instances,
+                           f.prototypes, f.instances_left_flat, used ? f.flat_triangles : scene.triangles.size(),
+                           uint64_t(std::max<int64_t>(0, embree.bytes())), embree.build_seconds()}
+      .to_json();
+}
+
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report) {
-  render(scene, *make_embree_scene(scene, settings.watertight, settings.embree_layout), settings, film, report);
+  render(scene, *make_embree_scene(scene, settings.watertight, settings.embree_layout, settings.instancing), settings,
+         film, report);
 }
 
 void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings& settings, Film& film,
@@ -73,6 +87,7 @@ void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings&
                                    {"probe_ns_per_ray", nullptr}};
   if (layout.triangles_ns > 0)
     report.extra["embree_layout"]["probe_ns_per_ray"] = {{"triangles", layout.triangles_ns}, {"quads", layout.quads_ns}};
+  report.extra["instancing"] = instancing_report(scene, embree, settings.instancing);
   // The ISA the path step ran with (scalar where the batched one does not apply:
   // double, other materials, big scenes), the one asked, and what the CPU offers.
   report.extra["isa"] = to_string(totals.isa);

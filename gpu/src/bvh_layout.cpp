@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/report.h"
 
 namespace pb::gpu {
 
@@ -20,6 +21,7 @@ constexpr struct {
 }  // namespace
 
 const char* to_string(GpuBvhLayout l) {
+  if (l == GpuBvhLayout::TwoLevel) return "two-level";  // chosen by --instancing, not by name
   for (const auto& n : kNames)
     if (n.layout == l) return n.name;
   return "?";
@@ -31,8 +33,9 @@ GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what) 
   throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute)", what, name));
 }
 
-GpuBvhOptions GpuBvhOptions::from_env() {
+GpuBvhOptions GpuBvhOptions::from_env(Instancing instancing) {
   GpuBvhOptions o;
+  o.instancing = instancing;
   if (const char* v = std::getenv("PATHBENCH_GPU_BVH"); v && *v) o.layout = parse_gpu_bvh_layout(v);
   if (const char* v = std::getenv("PATHBENCH_GPU_BRUTE_MAX_TRIS"); v && *v) {
     const std::string_view s(v);
@@ -46,7 +49,8 @@ GpuBvhOptions GpuBvhOptions::from_env() {
   return o;
 }
 
-GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles) {
+GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles, size_t instances) {
+  if (use_instancing(o.instancing, instances)) return GpuBvhLayout::TwoLevel;
   if (o.layout != GpuBvhLayout::Auto) return o.layout;
   return triangles <= o.brute_max_triangles ? GpuBvhLayout::Brute : kAutoLayout;
 }
@@ -54,8 +58,10 @@ GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles) {
 SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   SceneBvhHost out;
-  out.layout = resolve_layout(options, scene.triangles.size());
-  if (out.layout == GpuBvhLayout::Brute) {
+  out.layout = resolve_layout(options, scene.triangles.size(), scene.instances.size());
+  if (out.layout == GpuBvhLayout::TwoLevel) {
+    out.two_level = build_two_level_bvh(scene);
+  } else if (out.layout == GpuBvhLayout::Brute) {
     out.all.resize(scene.triangles.size());
     for (size_t i = 0; i < scene.triangles.size(); ++i) {
       const Triangle& t = scene.triangles[i];
@@ -96,6 +102,10 @@ BvhView SceneBvhHost::view() const {
       v.kind = TraversalKind::Wide;
       v.wide = wide.view();
       break;
+    case GpuBvhLayout::TwoLevel:
+      v.kind = TraversalKind::TwoLevel;
+      v.two_level = two_level.view();
+      break;
     default:
       v.kind = TraversalKind::Binary;
       v.binary = binary.view();
@@ -104,12 +114,27 @@ BvhView SceneBvhHost::view() const {
 }
 
 uint64_t SceneBvhHost::bytes() const {
-  return binary.bytes() + wide.bytes() + all.size() * sizeof(BvhTriangle);
+  return binary.bytes() + wide.bytes() + all.size() * sizeof(BvhTriangle) + two_level.bytes();
 }
-uint32_t SceneBvhHost::nodes() const { return uint32_t(binary.nodes.size() + wide.nodes.size()); }
+uint32_t SceneBvhHost::nodes() const {
+  return uint32_t(binary.nodes.size() + wide.nodes.size() + two_level.top_nodes.size() + two_level.bottom_nodes.size());
+}
 uint32_t SceneBvhHost::node_bytes() const {
   if (layout == GpuBvhLayout::Brute) return 0;
-  return layout == GpuBvhLayout::Binary ? uint32_t(sizeof(BvhNode)) : uint32_t(sizeof(WideNode));
+  return layout == GpuBvhLayout::Binary || layout == GpuBvhLayout::TwoLevel ? uint32_t(sizeof(BvhNode))
+                                                                            : uint32_t(sizeof(WideNode));
+}
+
+nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, Instancing asked) {
+  const bool used = bvh.layout == GpuBvhLayout::TwoLevel;
+  const TwoLevelHost& t = bvh.two_level;
+  const char* why = used                     ? "a two-level BVH over the scene's instances"
+                    : scene.instances.empty() ? "the scene has no instances: traced flat"
+                                              : "asked off: traced flat";
+  return InstancingSummary{asked, used, why, scene.instances.size(), scene.prototypes.size(), t.instanced,
+                           t.prototypes, t.instances_left_flat, used ? t.flat_triangles : scene.triangles.size(),
+                           bvh.bytes(), bvh.build_seconds}
+      .to_json();
 }
 
 }  // namespace pb::gpu

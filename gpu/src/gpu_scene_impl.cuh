@@ -4,6 +4,8 @@
 // build the report names.
 #include <cstdint>
 
+#include <nlohmann/json.hpp>
+
 #include "cuda_util.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/gpu/bvh_layout.h"
@@ -22,6 +24,10 @@ struct GpuScene::Impl {
   DeviceBuffer<BvhNode> nodes;      // the layout's nodes: binary...
   DeviceBuffer<WideNode> wide_nodes;  // ...or wide (brute force has none)
   DeviceBuffer<BvhTriangle> tris;    // in traversal order (brute force: scene order)
+  // The two-level BVH's (two_level_bvh.h; its triangles are `positions` and `triangles`).
+  DeviceBuffer<BvhNode> top_nodes, bottom_nodes;
+  DeviceBuffer<uint32_t> top_items, bottom_items;
+  DeviceBuffer<TwoLevelInstance> instances;
   SceneView view{};
   BvhView bvh{};
   uint64_t bytes = 0;
@@ -29,6 +35,8 @@ struct GpuScene::Impl {
   uint32_t bvh_nodes = 0, bvh_node_bytes = 0, bvh_tris = 0;
   uint32_t bvh_depth = 0, bvh_leaves = 0;
   double bvh_sah = 0, bvh_build_seconds = 0;
+  uint64_t bvh_bytes = 0;  // the acceleration structure's part of `bytes`
+  nlohmann::json instancing;  // what the report says of --instancing (scene_upload.cu)
 };
 
 }  // namespace pb::gpu

@@ -12,7 +12,8 @@
 
 namespace pb::gpu {
 
-HostGpuTracer::HostGpuTracer(const Scene& scene) : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env())) {}
+HostGpuTracer::HostGpuTracer(const Scene& scene, Instancing instancing)
+    : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env(instancing))) {}
 
 void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport& report) const {
   const SceneView view = scene_.view();
@@ -56,6 +57,7 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   report.rays.shadow += shadow;
   report.paths += paths;
   report.discarded_samples += discarded;
+  report.extra["instancing"] = instancing_report(scene_, bvh_, settings.instancing);
   report.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -74,7 +74,7 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
   // Start the context before measuring memory: its own use is not the tracer's.
   PB_CUDA_CHECK(cudaFree(nullptr));
   DeviceMemory::instance().begin_measurement();
-  GpuScene gpu_scene(scene);
+  GpuScene gpu_scene(scene, settings.instancing);
   render_impl(scene, gpu_scene, settings, film, report, profile, nullptr);
 }
 
@@ -219,9 +219,11 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
               {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth},
               {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
               {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
-                          : g.layout == GpuBvhLayout::Binary
-                              ? "embree rtcBuildBVH, binned SAH, binary"
+                          : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"
+                          : g.layout == GpuBvhLayout::TwoLevel
+                              ? "embree rtcBuildBVH, binned SAH, binary: over the instances, and one per prototype"
                               : "embree rtcBuildBVH, binned SAH, binary (leaves <= 3), collapsed greedily"}};
+  x["instancing"] = g.instancing;
   x["device_samples_per_second"] = device_ms > 0 ? double(r.stats.paths) / (device_ms / 1e3) : 0.0;
   x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
   if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;

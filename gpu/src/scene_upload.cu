@@ -11,6 +11,9 @@ namespace pb::gpu {
 
 GpuScene::GpuScene(const Scene& scene) : GpuScene(scene, GpuBvhOptions::from_env()) {}
 
+GpuScene::GpuScene(const Scene& scene, Instancing instancing)
+    : GpuScene(scene, GpuBvhOptions::from_env(instancing)) {}
+
 GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std::make_unique<Impl>()) {
   ensure_device();
   Impl& m = *impl_;
@@ -27,6 +30,12 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : bvh.layout == GpuBvhLayout::Binary ? bvh.binary.tris
                                                                                                   : bvh.wide.tris,
                 "BVH triangles", lower);
+  const TwoLevelHost& two = bvh.two_level;
+  m.top_nodes.assign(two.top_nodes, "BVH nodes", lower);
+  m.bottom_nodes.assign(two.bottom_nodes, "BVH nodes", lower);
+  m.top_items.assign(two.top_items, "BVH nodes", lower);
+  m.bottom_items.assign(two.bottom_items, "BVH nodes", lower);
+  m.instances.assign(two.instances, "BVH instances", lower);
   m.view = scene.view();
   m.view.positions = m.positions.get();
   m.view.triangles = m.triangles.get();
@@ -39,14 +48,24 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh.binary = {m.nodes.get(), m.tris.get(), uint32_t(m.nodes.size()), uint32_t(m.tris.size())};
   m.bvh.wide = {m.wide_nodes.get(), m.tris.get(), uint32_t(m.wide_nodes.size()), uint32_t(m.tris.size())};
   m.bvh.tris = m.tris.get();
+  m.bvh.two_level = {m.top_nodes.get(), m.top_items.get(), m.instances.get(), m.bottom_nodes.get(),
+                     m.bottom_items.get(), m.positions.get(), m.triangles.get()};
+  m.bvh_bytes = m.nodes.bytes() + m.wide_nodes.bytes() + m.tris.bytes() + m.top_nodes.bytes() +
+                m.bottom_nodes.bytes() + m.top_items.bytes() + m.bottom_items.bytes() + m.instances.bytes();
   m.bytes = m.positions.bytes() + m.triangles.bytes() + m.material_ids.bytes() + m.materials.bytes() +
-            m.emitters.bytes() + m.emitter_cdf.bytes() + m.nodes.bytes() + m.wide_nodes.bytes() + m.tris.bytes();
+            m.emitters.bytes() + m.emitter_cdf.bytes() + m.bvh_bytes;
+  m.instancing = instancing_report(scene, bvh, options.instancing);
+  m.instancing["accel_device_bytes"] = m.bvh_bytes;
   m.layout = bvh.layout;
   m.bvh_nodes = bvh.nodes();
   m.bvh_node_bytes = bvh.node_bytes();
   m.bvh_tris = uint32_t(m.tris.size());
   m.bvh_depth = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_depth : bvh.wide.depth;
   m.bvh_leaves = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_leaves : bvh.wide.leaves;
+  if (bvh.layout == GpuBvhLayout::TwoLevel) {  // the deepest top-to-triangle path; triangle references
+    m.bvh_depth = two.top_depth + two.bottom_depth;
+    m.bvh_tris = uint32_t(two.bottom_items.size());
+  }
   m.bvh_sah = bvh.binary_sah;
   m.bvh_build_seconds = bvh.build_seconds;
 }

@@ -48,17 +48,18 @@ _Device = Literal["cpu", "gpu"]
 _Precision = Literal["float", "double"]
 _Layout = Literal["auto", "triangles", "quads"]
 _Isa = Literal["auto", "avx512", "avx2", "scalar"]
+_Instancing = Literal["auto", "on", "off"]
 _Image = npt.NDArray[np.float32]
 
 @overload
 def render(scene: Scene, width: int, height: int, spp: int, *, bounces: int | None = None,
            converged: bool = False, rr: bool = False, sampling: _Sampling = "nee", strategy: _Strategy = "pixel",
            device: _Device = "cpu", precision: _Precision = "float", embree_layout: _Layout = "auto",
-           isa: _Isa = "auto", seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
+           isa: _Isa = "auto", instancing: _Instancing = "auto", seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
            variance: Literal[False] = False, profile: bool = False) -> tuple[_Image, dict[str, object]]: ...
 @overload
 def render(scene: Scene, width: int, height: int, spp: int, *, bounces: int | None = None,
            converged: bool = False, rr: bool = False, sampling: _Sampling = "nee", strategy: _Strategy = "pixel",
            device: _Device = "cpu", precision: _Precision = "float", embree_layout: _Layout = "auto",
-           isa: _Isa = "auto", seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
+           isa: _Isa = "auto", instancing: _Instancing = "auto", seed: int = 0, paths_in_flight: int = 0, threads: int = 0, watertight: bool = True,
            variance: Literal[True], profile: bool = False) -> tuple[_Image, dict[str, object], _Image]: ...

@@ -55,7 +55,7 @@ py::tuple render(const SceneHandle& s, const py::object& width, const py::object
                  const py::object& bounces, const py::object& converged, const py::object& rr,
                  const py::object& sampling, const py::object& strategy, const py::object& device,
                  const py::object& precision, const py::object& embree_layout, const py::object& isa,
-                 const py::object& seed,
+                 const py::object& instancing, const py::object& seed,
                  const py::object& paths_in_flight, const py::object& threads, const py::object& watertight,
                  const py::object& variance, const py::object& profile) {
   RenderSettings rs;
@@ -75,6 +75,7 @@ py::tuple render(const SceneHandle& s, const py::object& width, const py::object
   c.precision = str_arg(precision, "precision");
   c.embree_layout = str_arg(embree_layout, "embree_layout");
   c.isa = str_arg(isa, "isa");
+  c.instancing = str_arg(instancing, "instancing");
   rs.seed = uint64_arg(seed, "seed");
   rs.paths_in_flight = uint64_arg(paths_in_flight, "paths_in_flight");
   rs.threads = int(int_arg(threads, "threads", std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
@@ -133,7 +134,7 @@ void def_render(py::module_& m) {
         py::arg("bounces") = py::none(), py::arg("converged") = false, py::arg("rr") = false,
         py::arg("sampling") = "nee", py::arg("strategy") = "pixel", py::arg("device") = "cpu",
         py::arg("precision") = "float", py::arg("embree_layout") = "auto", py::arg("isa") = "auto",
-        py::arg("seed") = 0,
+        py::arg("instancing") = "auto", py::arg("seed") = 0,
         py::arg("paths_in_flight") = 0, py::arg("threads") = 0, py::arg("watertight") = true,
         py::arg("variance") = false, py::arg("profile") = false,
         "Renders `scene` as `pathbench render` does, with the same options as keywords (--embree-layout is\n"

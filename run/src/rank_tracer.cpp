@@ -20,7 +20,7 @@ struct RankTracer::Cpu {
 
 struct RankTracer::Gpu {
 #if PATHBENCH_HAVE_CUDA
-  explicit Gpu(const Scene& s) : scene(s) {}
+  Gpu(const Scene& s, Instancing instancing) : scene(s, instancing) {}
   gpu::GpuScene scene;
   gpu::DeviceFilm film;  // every block's samples, downloaded once (finish)
 #endif
@@ -32,13 +32,14 @@ RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const
   if (settings_.device == Device::Cpu) {
     // Built once for every chunk (a million-triangle scene takes Embree a second).
     cpu_ = std::make_unique<Cpu>();
-    if (gpu_samples) cpu_->gpu_bvh = std::make_unique<gpu::HostGpuTracer>(scene);
-    else cpu_->scene = cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout);
+    if (gpu_samples) cpu_->gpu_bvh = std::make_unique<gpu::HostGpuTracer>(scene, settings_.instancing);
+    else cpu_->scene = cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout,
+                                                      settings_.instancing);
   } else {
     std::string why;
     if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
 #if PATHBENCH_HAVE_CUDA
-    gpu_ = std::make_unique<Gpu>(scene);  // BVH built and uploaded once for every chunk
+    gpu_ = std::make_unique<Gpu>(scene, settings_.instancing);  // BVH built and uploaded once for every chunk
 #endif
   }
 }

@@ -105,10 +105,10 @@ std::string settings_key(const Scene& scene, const RenderSettings& s) {
   mix(scene.materials.data(), scene.materials.size() * sizeof(scene.materials[0]));
   return fmt::format(
       "scene={} scene_hash={:016x} width={} height={} spp={} bounces={} sampling={} strategy={} seed={} rr={} "
-      "rr_start={} paths_in_flight={} variance={} watertight={} precision={} embree_layout={} isa={}",
+      "rr_start={} paths_in_flight={} variance={} watertight={} precision={} embree_layout={} isa={} instancing={}",
       scene.name, h, s.width, s.height, s.spp, s.max_bounces, to_string(s.sampling), to_string(s.strategy), s.seed,
       s.russian_roulette, s.rr_start_depth, s.paths_in_flight, s.variance, s.watertight, to_string(s.precision),
-      to_string(s.embree_layout), to_string(s.isa));
+      to_string(s.embree_layout), to_string(s.isa), to_string(s.instancing));
 }
 
 bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report,

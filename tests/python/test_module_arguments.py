@@ -1,6 +1,7 @@
 """`pathbench`'s arguments: no silent cast, shapes and layouts, and render() taking the
 CLI's options through the CLI's own validation (messages in keyword terms)."""
 import os
+import pathlib
 import re
 
 import numpy as np
@@ -82,6 +83,8 @@ def test_any_real_dtype_and_any_layout_give_the_same_hits(box):
     (dict(precision="half"), ValueError, "precision: unknown precision 'half'"),
     (dict(embree_layout="strips"), ValueError, "embree_layout: unknown layout 'strips'"),
     (dict(embree_layout=1), TypeError, "embree_layout must be a str"),
+    (dict(instancing="maybe"), ValueError, "instancing: unknown choice 'maybe' (expected auto, on or off)"),
+    (dict(instancing=True), TypeError, "instancing must be a str"),
     (dict(rr=1), TypeError, "rr must be True or False"),
     (dict(variance=None), TypeError, "variance must be True or False"),
 ])
@@ -109,6 +112,17 @@ def test_render_takes_every_cli_option(box):
     assert report["watertight"] is False and report["paths_in_flight"] == 16
     image2, _, variance = pathbench.render(box, 8, 4, 2, variance=True, bounces=1, rr=True, seed=7)
     assert variance.shape == image2.shape and variance.dtype == np.float32 and (variance >= 0).all()
+
+
+def test_instancing_keyword_gives_the_flat_image():
+    # Embree instances of the example's eight cubes: the flat scene's image, and the report says so.
+    scene = pathbench.load_scene(str(pathlib.Path(__file__).parents[2] / "scenes/examples/instancing.json"))
+    flat, flat_report = pathbench.render(scene, 16, 12, 2, instancing="off")
+    inst, inst_report = pathbench.render(scene, 16, 12, 2, instancing="on")
+    assert np.array_equal(flat, inst)
+    assert flat_report["instancing"]["used"] is False and inst_report["instancing"]["used"] is True
+    assert inst_report["instancing"]["instances"] == 8
+    assert inst_report["instancing"]["accel_bytes"] < flat_report["instancing"]["accel_bytes"]
 
 
 def test_device_gpu_runs_or_says_why_not(box):

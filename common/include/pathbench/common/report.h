@@ -18,6 +18,21 @@ struct RayCounts {
   }
 };
 
+// What a render's report says of --instancing (report.extra["instancing"]), the same on
+// both devices: asked, used, why; the scene's instances and prototypes and those the
+// acceleration structure built; instances left flat (they lost triangles to finalize()),
+// triangles traced flat; the structure's bytes and build time.
+struct InstancingSummary {
+  Instancing asked = Instancing::Auto;
+  bool used = false;
+  const char* why = "";
+  uint64_t scene_instances = 0, scene_prototypes = 0;
+  uint64_t instances = 0, prototypes = 0, instances_left_flat = 0, flat_triangles = 0;
+  uint64_t accel_bytes = 0;
+  double accel_build_seconds = 0;
+  nlohmann::json to_json() const;
+};
+
 struct RunReport {
   std::string scene;
   uint64_t triangles = 0;

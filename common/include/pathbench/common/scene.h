@@ -129,6 +129,14 @@ struct Scene {
   void rebase_far_from_origin();  // part of finalize()
 };
 
+// An instance's prototype coordinates -> the traced ones (to_world less Scene::origin).
+Affine traced_to_world(const Scene& s, const SceneInstance& in);
+// The largest difference (max norm, traced units) between a vertex of the instance's flat
+// triangles and the matching prototype vertex under traced_to_world, in double: the
+// rounding its expansion went through (half an ulp; more where the scene was rebased far
+// from the origin or rescaled). Infinity where the instance lost triangles to finalize().
+double instance_deviation(const Scene& s, const SceneInstance& in);
+
 // The scene with every point p (user coordinates) moved to p * scale + offset, the
 // camera too, then finalized again (bounds, offsets and origin follow). Throws
 // InputError for a scale that is not finite and positive or an offset that is not finite.

@@ -1,6 +1,7 @@
 #pragma once
 // What to render and how. RenderSettings is the user's request; PathConfig is the
 // part the path step reads, small and plain so it can be passed to kernels by value.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -29,6 +30,12 @@ enum class EmbreeLayout : uint32_t { Auto = 0, Triangles = 1, Quads = 2 };
 // widest the CPU has (AVX-512: 16 lanes, AVX2: 8), Scalar the reference path step one
 // path at a time. Every choice gives the same image bit for bit. The GPU ignores it.
 enum class Isa : uint32_t { Auto = 0, Avx512 = 1, Avx2 = 2, Scalar = 3 };
+// Whether the acceleration structure is built from the scene's instances (Scene::instances:
+// Embree instances on the CPU, a two-level BVH on the GPU) or from the flat, expanded
+// triangles. Either way the hit is recomputed on the flat triangle, so shading is the flat
+// scene's. Auto: on when the scene has instances. On for a scene without instances traces
+// it flat (the report says so). Off: the flat BVH.
+enum class Instancing : uint32_t { Auto = 0, On = 1, Off = 2 };
 
 struct PathConfig {
   int32_t max_bounces;        // diffuse reflections; -1 = unbounded (Russian roulette ends paths)
@@ -62,6 +69,7 @@ struct RenderSettings {
   Precision precision = Precision::Float;  // scalar type of the path step
   EmbreeLayout embree_layout = EmbreeLayout::Auto;  // CPU only
   Isa isa = Isa::Auto;                               // CPU only
+  Instancing instancing = Instancing::Auto;          // both devices
   bool progress = true;
   // The samples of every pixel this render traces: [first_sample, first_sample +
   // traced_spp()); sample_count 0 = all spp. The run layer sets them for an MPI rank's
@@ -93,6 +101,7 @@ struct RenderChoices {
   std::string embree_layout = "auto";
   std::string isa = "auto";  // CPU: instruction set of the batched path step
   bool converged = false;  // unbounded paths ended by Russian roulette (max_bounces = -1, rr on)
+  std::string instancing = "auto";
 };
 // Parses the names into `s` and applies `converged`. Throws InputError naming the CLI
 // option (--sampling, ...); the Python module renames those to its keywords. The settings
@@ -105,11 +114,18 @@ const char* to_string(Device d);
 const char* to_string(Precision p);
 const char* to_string(EmbreeLayout l);
 const char* to_string(Isa i);
+const char* to_string(Instancing i);
 Sampling parse_sampling(std::string_view s);  // throw InputError on unknown names
 Strategy parse_strategy(std::string_view s);
 Device parse_device(std::string_view s);
 Precision parse_precision(std::string_view s);
 EmbreeLayout parse_embree_layout(std::string_view s);
 Isa parse_isa(std::string_view s);
+Instancing parse_instancing(std::string_view s);
+// Whether `asked` builds the acceleration structure from instances for a scene with
+// `instances` instances (Auto and On: where it has any).
+constexpr bool use_instancing(Instancing asked, size_t instances) {
+  return asked != Instancing::Off && instances > 0;
+}
 
 }  // namespace pb

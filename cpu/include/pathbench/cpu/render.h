@@ -19,6 +19,11 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
 void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings& settings, Film& film,
             RunReport& report);
 
+// What report.extra["instancing"] says: asked, used, why, instances and prototypes
+// (the scene's and those built), triangles traced flat, the acceleration structure's
+// bytes (Embree's, after the build) and its build time.
+nlohmann::json instancing_report(const Scene& scene, const EmbreeScene& embree, Instancing asked);
+
 // Default number of paths in flight for the wavefront strategy.
 uint64_t default_paths_in_flight(int threads);
 

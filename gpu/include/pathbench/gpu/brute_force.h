@@ -13,7 +13,7 @@ namespace pb::gpu {
 
 // Closest hit (kAnyHit = false) or any hit among tris[0..n), as traverse() in bvh.h:
 // same triangle test, so the same answer (of two triangles at exactly the same t, the
-// first in scene order).
+// lower id: detail::closer).
 template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse_all(const BvhTriangle* tris, uint32_t n, const Vec3f& o, const Vec3f& d, float t_max,
                             float& t_hit, TraversalStats* stats = nullptr) {
@@ -21,7 +21,7 @@ PB_HD uint32_t traverse_all(const BvhTriangle* tris, uint32_t n, const Vec3f& o,
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   for (uint32_t i = 0; i < n; ++i) {
-    if (detail::test_triangle<kWatertight>(tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+    if (detail::test_triangle<kWatertight>(tris, i, wr, o, d, t_max, t, hit, hit_slot, stats) && kAnyHit) {
       t_hit = t;
       return hit;
     }

@@ -109,25 +109,44 @@ PB_HD float safe_inverse(float d) {
   return 1.0f / (std::fabs(d) > kTiny ? d : (d >= 0.0f ? kTiny : -kTiny));
 }
 
-// Tests triangle slot i of `tris` for a hit closer than t; on a hit narrows t to it and
-// records the triangle (scene id and slot). Every traversal's leaf test.
+// The closest hit is the least (t, scene triangle id): on an exact tie in t the lower id
+// wins, whatever order a traversal tests the triangles in, so that every traversal of
+// one scene (binary, wide, all triangles, the instanced two-level one) names the same
+// triangle. A triangle is tested against t_max widened a little past the best t so far
+// (kTieSlack, far above the rounding of the test's own T < t_max * det): every triangle
+// whose computed t is <= the best t is then computed in full and compared, and the
+// answer depends on the triangles alone, not on the order they come in.
+constexpr float kTieSlack = 1.0f + 0x1p-20f;
+PB_HD bool closer(float tt, uint32_t prim, float t, uint32_t hit) { return tt < t || (tt == t && prim < hit); }
+
+// Tests triangle (a, b, c), scene id `prim`, for a hit in (0, t_max) that is closer
+// than (t, hit); on one narrows t to it and records prim.
+template <bool kWatertight>
+PB_HD bool test_vertices(const Vec3f& a, const Vec3f& b, const Vec3f& c, uint32_t prim, const WatertightRay& wr,
+                         const Vec3f& o, const Vec3f& d, float t_max, float& t, uint32_t& hit) {
+  const float bound = hit == kNoHit ? t_max : pmin(t_max, t * kTieSlack);
+  float tt;
+  bool h;
+  if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, bound, tt);
+  else h = intersect_moller_trumbore(o, d, a, b, c, bound, tt);
+  if (!h || !closer(tt, prim, t, hit)) return false;
+  t = tt;
+  hit = prim;
+  return true;
+}
+
+// The same for triangle slot i of `tris`, recording the slot too. Every traversal's
+// leaf test but the two-level one's (two_level_bvh.h).
 template <bool kWatertight>
 PB_HD bool test_triangle(const BvhTriangle* tris, uint32_t i, const WatertightRay& wr, const Vec3f& o, const Vec3f& d,
-                         float& t, uint32_t& hit, uint32_t& hit_slot, TraversalStats* stats) {
+                         float t_max, float& t, uint32_t& hit, uint32_t& hit_slot, TraversalStats* stats) {
   Vec3f a, b, c;
   uint32_t prim;
   load_triangle(tris, i, a, b, c, prim);
   if (stats) ++stats->tris;
-  float tt;
-  bool h;
-  if constexpr (kWatertight) h = intersect_watertight(wr, a, b, c, t, tt);
-  else h = intersect_moller_trumbore(o, d, a, b, c, t, tt);
-  if (h) {
-    t = tt;
-    hit = prim;
-    hit_slot = i;
-  }
-  return h;
+  if (!test_vertices<kWatertight>(a, b, c, prim, wr, o, d, t_max, t, hit)) return false;
+  hit_slot = i;
+  return true;
 }
 
 // The closest hit's answer. Woop's t ordered the candidates; the winner's t comes from
@@ -160,32 +179,31 @@ constexpr float kFarScale = 1.0000004f;
 
 }  // namespace detail
 
-// Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
-// own direction (need not be unit length). Returns the scene triangle id, or kNoHit;
-// t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
-// Moeller-Trumbore (the paper's; the accuracy study's comparison).
-template <bool kAnyHit, bool kWatertight = true>
-PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
-                        TraversalStats* stats = nullptr) {
-  const WatertightRay wr = make_watertight_ray(o, d);
-  const auto [inv, oi] = detail::make_slab_ray(o, d);
-  using detail::kFarScale;
+namespace detail {
+
+// Walks a binary BVH (node 0 the root) front to back for the ray (o, d), skipping boxes
+// beyond `t`, the best distance so far (read at every node: the leaf test narrows it).
+// leaf(first, count) tests a leaf's items and returns true to end the walk (an any-hit
+// query's hit); then walk_binary returns true. Shared by the flat traversal below and
+// both levels of the two-level one (two_level_bvh.h).
+template <class Leaf>
+PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, const float& t, Leaf&& leaf,
+                       TraversalStats* stats) {
+  const auto [inv, oi] = make_slab_ray(o, d);
   uint32_t stack[kTraversalStackSize];
   int sp = 0;
   uint32_t ref = 0;
-  uint32_t hit = kNoHit, hit_slot = 0;
-  float t = t_max;
   for (;;) {
     while (!is_leaf(ref)) {
       float x[4], y[4], z[4];
       uint32_t child[2];
-      detail::load_node(bvh.nodes, ref, x, y, z, child);
+      load_node(nodes, ref, x, y, z, child);
       if (stats) ++stats->nodes;
       float tn[2], tf[2];
       for (int c = 0; c < 2; ++c) {
-        const float tx0 = detail::fmadd(x[2 * c], inv.x, oi.x), tx1 = detail::fmadd(x[2 * c + 1], inv.x, oi.x);
-        const float ty0 = detail::fmadd(y[2 * c], inv.y, oi.y), ty1 = detail::fmadd(y[2 * c + 1], inv.y, oi.y);
-        const float tz0 = detail::fmadd(z[2 * c], inv.z, oi.z), tz1 = detail::fmadd(z[2 * c + 1], inv.z, oi.z);
+        const float tx0 = fmadd(x[2 * c], inv.x, oi.x), tx1 = fmadd(x[2 * c + 1], inv.x, oi.x);
+        const float ty0 = fmadd(y[2 * c], inv.y, oi.y), ty1 = fmadd(y[2 * c + 1], inv.y, oi.y);
+        const float tz0 = fmadd(z[2 * c], inv.z, oi.z), tz1 = fmadd(z[2 * c + 1], inv.z, oi.z);
         tn[c] = pmax(pmax(pmin(tx0, tx1), pmin(ty0, ty1)), pmax(pmin(tz0, tz1), 0.0f));
         tf[c] = pmin(pmin(pmax(tx0, tx1), pmax(ty0, ty1)), pmax(tz0, tz1)) * kFarScale;
         tf[c] = pmin(tf[c], t);
@@ -198,19 +216,40 @@ PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d
       } else if (h0 || h1) {
         ref = h0 ? child[0] : child[1];
       } else {
-        if (sp == 0) return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
+        if (sp == 0) return false;
         ref = stack[--sp];
       }
     }
-    const uint32_t first = leaf_first(ref), count = leaf_count(ref);
-    for (uint32_t i = first; i < first + count; ++i) {
-      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
-        t_hit = t;
-        return hit;
-      }
-    }
-    if (sp == 0) break;
+    if (leaf(leaf_first(ref), leaf_count(ref))) return true;
+    if (sp == 0) return false;
     ref = stack[--sp];
+  }
+}
+
+}  // namespace detail
+
+// Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
+// own direction (need not be unit length). Returns the scene triangle id, or kNoHit;
+// t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
+// Moeller-Trumbore (the paper's; the accuracy study's comparison).
+template <bool kAnyHit, bool kWatertight = true>
+PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
+                        TraversalStats* stats = nullptr) {
+  const WatertightRay wr = make_watertight_ray(o, d);
+  uint32_t hit = kNoHit, hit_slot = 0;
+  float t = t_max;
+  const bool stopped = detail::walk_binary(
+      bvh.nodes, o, d, t,
+      [&](uint32_t first, uint32_t count) {
+        for (uint32_t i = first; i < first + count; ++i)
+          if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, t, hit, hit_slot, stats) && kAnyHit)
+            return true;
+        return false;
+      },
+      stats);
+  if (kAnyHit && stopped) {
+    t_hit = t;
+    return hit;
   }
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }

@@ -3,7 +3,9 @@
 //   binary  the binary BVH (bvh.h), 64-byte nodes;
 //   wide4 / wide8  the compressed wide BVH (wide_bvh.h), 80-byte nodes of <= 4 / 8 children;
 //   brute   no BVH: every triangle tested (brute_force.h), for tiny scenes;
-//   auto    brute at most `brute_max_triangles` triangles, else kAutoLayout.
+//   auto    brute at most `brute_max_triangles` triangles, else kAutoLayout;
+//   two-level  the instanced scene's (two_level_bvh.h): not asked for by name but by
+//           GpuBvhOptions::instancing (--instancing), on a scene with instances.
 // The choice comes from GpuBvhOptions (GpuScene's constructor: one process can A/B
 // them), by default from the environment: PATHBENCH_GPU_BVH=<name>,
 // PATHBENCH_GPU_BRUTE_MAX_TRIS=<n>. Plain C++ (tests build it without CUDA).
@@ -11,14 +13,18 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "pathbench/common/scene.h"
+#include "pathbench/common/settings.h"
 #include "pathbench/gpu/bvh_build.h"
 #include "pathbench/gpu/traversal.h"
+#include "pathbench/gpu/two_level_build.h"
 #include "pathbench/gpu/wide_bvh_build.h"
 
 namespace pb::gpu {
 
-enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4 };
+enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5 };
 
 // Measured on an H100 (results/nvidia-h100-80gb-hbm3/layouts-a12fc4c, interleaved,
 // CUDA events): the binary BVH is the fastest everywhere we measured — paper-cornell
@@ -32,16 +38,20 @@ constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute for
 struct GpuBvhOptions {
   GpuBvhLayout layout = GpuBvhLayout::Auto;
   uint32_t brute_max_triangles = kDefaultBruteMaxTriangles;  // auto: brute force up to this many
-  // From PATHBENCH_GPU_BVH and PATHBENCH_GPU_BRUTE_MAX_TRIS where set; throws InputError
-  // naming the variable for a value it cannot use.
-  static GpuBvhOptions from_env();
+  // The render's --instancing: where use_instancing() says so, the two-level BVH
+  // whatever `layout` says.
+  Instancing instancing = Instancing::Off;
+  // From PATHBENCH_GPU_BVH and PATHBENCH_GPU_BRUTE_MAX_TRIS where set, with the render's
+  // --instancing; throws InputError naming the variable for a value it cannot use.
+  static GpuBvhOptions from_env(Instancing instancing = Instancing::Off);
 };
 
 const char* to_string(GpuBvhLayout l);
 // Throws InputError naming `what` (the option or variable) for an unknown name.
 GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what = "PATHBENCH_GPU_BVH");
-// `auto` resolved for a scene of `triangles` triangles; other layouts are kept.
-GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles);
+// `auto` resolved for a scene of `triangles` triangles and `instances` instances; other
+// layouts are kept (but for instancing, above).
+GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles, size_t instances = 0);
 
 // The structure built for one layout, ready to upload (only the layout's arrays are filled).
 struct SceneBvhHost {
@@ -49,6 +59,7 @@ struct SceneBvhHost {
   BvhHost binary;                  // Binary
   WideBvhHost wide;                // Wide4, Wide8
   std::vector<BvhTriangle> all;    // Brute: the triangles in scene order
+  TwoLevelHost two_level;          // TwoLevel
   uint32_t binary_depth = 0, binary_leaves = 0;  // the binary BVH the wide one came from
   double binary_sah = 0, build_seconds = 0;
 
@@ -59,5 +70,10 @@ struct SceneBvhHost {
 };
 
 SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options);
+
+// What a report says of --instancing for the structure `bvh` built for `scene`: asked, used,
+// why, instances and prototypes (the scene's and those built), triangles left flat, the
+// structure's bytes and build time (report.extra["instancing"], GPU and HostGpuTracer).
+nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, Instancing asked);
 
 }  // namespace pb::gpu

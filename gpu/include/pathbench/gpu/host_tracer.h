@@ -19,9 +19,9 @@ namespace pb::gpu {
 
 class HostGpuTracer {
  public:
-  // Builds the BVH as the GPU tracer does (GpuBvhOptions::from_env()). `scene` must
-  // outlive the tracer.
-  explicit HostGpuTracer(const Scene& scene);
+  // Builds the BVH as the GPU tracer does (GpuBvhOptions::from_env(), with the
+  // render's --instancing). `scene` must outlive the tracer.
+  explicit HostGpuTracer(const Scene& scene, Instancing instancing = Instancing::Off);
   // Traces samples [first_sample, first_sample + traced_spp()) of every pixel into
   // `film` (begun by the caller; Film::add, so a sample the GPU would discard is
   // discarded here too) on settings.threads threads (0: all), and adds the rays, paths,
@@ -29,6 +29,7 @@ class HostGpuTracer {
   void render(const RenderSettings& settings, Film& film, RunReport& report) const;
   std::string layout() const { return to_string(bvh_.layout); }
   uint64_t bvh_bytes() const { return bvh_.bytes(); }
+  const SceneBvhHost& bvh() const { return bvh_; }
 
  private:
   const Scene& scene_;

@@ -50,6 +50,8 @@ class GpuScene {
  public:
   explicit GpuScene(const Scene& scene);
   GpuScene(const Scene& scene, const GpuBvhOptions& options);
+  // From the environment, with the render's --instancing (a two-level BVH where it applies).
+  GpuScene(const Scene& scene, Instancing instancing);
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;

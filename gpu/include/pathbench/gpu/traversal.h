@@ -11,13 +11,15 @@
 #include "pathbench/common/hd.h"
 #include "pathbench/gpu/brute_force.h"
 #include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/two_level_bvh.h"
 #include "pathbench/gpu/wide_bvh.h"
 
 namespace pb::gpu {
 
 // Binary: bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
-// brute_force.h, the triangles in scene order in `tris` and no nodes.
-enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2 };
+// brute_force.h, the triangles in scene order in `tris` and no nodes. TwoLevel:
+// two_level_bvh.h, the instanced scene's (--instancing).
+enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3 };
 
 struct BvhView {
   BvhView() = default;
@@ -28,6 +30,7 @@ struct BvhView {
   WideBvhView wide{};
   const BvhTriangle* tris = nullptr;  // AllTriangles
   uint32_t num_tris = 0;
+  TwoLevelView two_level{};
 };
 
 // kKind: a TraversalKind the caller was compiled for (bvh.kind must be it), or
@@ -43,9 +46,13 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
     return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::Binary)) {
     return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::TwoLevel)) {
+    return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
   } else {
     switch (bvh.kind) {
       case TraversalKind::Wide: return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
+      case TraversalKind::TwoLevel:
+        return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
       case TraversalKind::AllTriangles:
         return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats);
       default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
@@ -70,6 +77,7 @@ decltype(auto) with_traversal_kind(TraversalKind kind, Fn&& fn) {
   switch (kind) {
     case TraversalKind::Wide: return fn(std::integral_constant<int, int(TraversalKind::Wide)>{});
     case TraversalKind::AllTriangles: return fn(std::integral_constant<int, int(TraversalKind::AllTriangles)>{});
+    case TraversalKind::TwoLevel: return fn(std::integral_constant<int, int(TraversalKind::TwoLevel)>{});
     default: return fn(std::integral_constant<int, int(TraversalKind::Binary)>{});
   }
 }

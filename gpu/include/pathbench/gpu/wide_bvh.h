@@ -129,8 +129,8 @@ PB_HD float byte_as_float(uint32_t w, int k) {
 }  // namespace detail
 
 // Closest hit (kAnyHit = false) or any hit, as traverse() in bvh.h: same triangle test,
-// same answer (the triangle with the smallest t; which of two at exactly the same t
-// depends on the order of the tests).
+// same answer (the triangle with the smallest t; of two at exactly the same t, the lower
+// id: detail::closer).
 template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                              TraversalStats* stats = nullptr) {
@@ -212,7 +212,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       const uint32_t k = detail::lowest_bit(thits);
       thits &= thits - 1u;
       const uint32_t i = tbase + k;
-      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t, hit, hit_slot, stats) && kAnyHit) {
+      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, t, hit, hit_slot, stats) && kAnyHit) {
         t_hit = t;
         return hit;
       }

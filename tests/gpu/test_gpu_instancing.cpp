@@ -1,0 +1,107 @@
+// --instancing on the GPU (label gpu; SKIPPED without a device): the two-level BVH
+// (gpu/two_level_bvh.h) gives the flat BVH's film byte for byte, for both strategies,
+// and HostGpuTracer's (the same code on the CPU: tests/gpu/test_two_level.cpp); ray by
+// ray the device's two-level traversal answers as the host's.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pathbench/common/scene_library.h"
+#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/gpu/render.h"
+
+namespace pb::gpu {
+namespace {
+
+const std::string kRoot = std::string(PATHBENCH_SOURCE_DIR) + "/";
+
+#define PB_REQUIRE_GPU()                                             \
+  do {                                                               \
+    std::string why;                                                 \
+    if (!device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
+  } while (0)
+
+Scene quiet_load(const std::string& path) {
+  testing::internal::CaptureStderr();
+  Scene s = load_scene(kRoot + path);
+  testing::internal::GetCapturedStderr();
+  return s;
+}
+
+Film gpu_film(const Scene& scene, const GpuScene& gs, const RenderSettings& s, RunReport& r) {
+  Film f(s.width, s.height, false);
+  f.begin(s.spp, scene.max_emission());
+  render(scene, gs, s, f, r, false);
+  return f;
+}
+
+TEST(GpuInstancing, FilmsEqualFlatAndHost) {
+  PB_REQUIRE_GPU();
+  for (const char* name : {"scenes/examples/instancing.json", "tests/data/scenes/instances/grid-125.json",
+                           "tests/data/scenes/formats/instanced.xml", "tests/data/scenes/formats/instanced.gltf",
+                           "scenes/examples/pyramids.gltf"}) {
+    const Scene scene = quiet_load(name);
+    const GpuScene flat(scene, Instancing::Off), inst(scene, Instancing::On);
+    for (Strategy strategy : {Strategy::Pixel, Strategy::Wavefront})
+      for (Precision precision : {Precision::Float, Precision::Double}) {
+        SCOPED_TRACE(testing::Message() << name << " " << to_string(strategy) << " " << to_string(precision));
+        RenderSettings s;
+        s.width = 96;
+        s.height = 72;
+        s.spp = 8;
+        s.device = Device::Gpu;
+        s.strategy = strategy;
+        s.precision = precision;
+        s.seed = 21;
+        s.progress = false;
+        RunReport rf, ri, rh;
+        s.instancing = Instancing::Off;
+        const Film a = gpu_film(scene, flat, s, rf);
+        s.instancing = Instancing::On;
+        const Film b = gpu_film(scene, inst, s, ri);
+        EXPECT_EQ(a.raw_sums(), b.raw_sums());
+        EXPECT_EQ(rf.extra["instancing"]["used"], false);
+        EXPECT_EQ(ri.extra["instancing"]["used"], true);
+        if (strategy == Strategy::Pixel) {  // HostGpuTracer is the pixel megakernel's loop
+          Film h(s.width, s.height, false);
+          h.begin(s.spp, scene.max_emission());
+          HostGpuTracer(scene, Instancing::On).render(s, h, rh);
+          EXPECT_EQ(h.raw_sums(), b.raw_sums());
+        }
+      }
+  }
+}
+
+TEST(GpuInstancing, DeviceTraversalAnswersAsTheHost) {
+  PB_REQUIRE_GPU();
+  const Scene s = quiet_load("tests/data/scenes/instances/grid-125.json");
+  GpuBvhOptions o;
+  o.instancing = Instancing::On;
+  const SceneBvhHost host = build_scene_bvh(s, o);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<uint32_t> tri(0, uint32_t(s.triangles.size() - 1));
+  std::vector<TraceQuery> rays;
+  for (int i = 0; i < 20000; ++i) {
+    const Triangle& t = s.triangles[tri(rng)];
+    const Vec3f to = i % 2 ? s.positions[t.v[0]] : (s.positions[t.v[1]] + s.positions[t.v[2]]) * 0.5f;
+    rays.push_back({s.camera.position, normalize(to - s.camera.position), 1e30f});
+  }
+  for (bool any : {false, true}) {
+    const std::vector<TraceResult> dev = trace_on_device(s, rays, any, o);
+    int differ = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      float t = 0;
+      const uint32_t h = any ? traverse<true>(host.view(), rays[i].o, rays[i].d, rays[i].t_max, t)
+                             : traverse<false>(host.view(), rays[i].o, rays[i].d, rays[i].t_max, t);
+      differ += (h == kNoHit) != (dev[i].prim == kNoHit) || (!any && (h != dev[i].prim || t != dev[i].t));
+    }
+    EXPECT_EQ(differ, 0) << (any ? "any hit" : "closest hit");
+  }
+}
+
+}  // namespace
+}  // namespace pb::gpu
