@@ -43,8 +43,8 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
       ->capture_default_str();
   cmd.add_option("--instancing", o.choices.instancing,
                  "acceleration structure from the scene's instances (CPU: Embree instances, GPU: a two-level BVH): "
-                 "auto (where the scene has instances), on, or off (the flat triangles); the GPU's image is the flat one "
-                 "bit for bit, the CPU's but for rare rays meeting a copy's edge (cpu/NOTES.md)")
+                 "auto (GPU: where the scene has instances; CPU: flat), on, or off (the flat triangles); the GPU's image "
+                 "is the flat one bit for bit, the CPU's with 'on' but for rare rays meeting a copy's edge (cpu/NOTES.md)")
       ->capture_default_str();
   cmd.add_option("--isa", o.choices.isa,
                  "CPU: instruction set of the batched path step: auto (widest the CPU has), avx512, avx2 or scalar; "

@@ -23,7 +23,10 @@ nlohmann::json instancing_report(const Scene& scene, const EmbreeScene& embree, 
   const char* why = used                     ? "Embree instances of the scene's prototypes"
                     : scene.instances.empty() ? "the scene has no instances: traced flat"
                     : asked == Instancing::Off ? "asked off: traced flat"
-                                               : "the quads layout asked for: traced flat";
+                    : asked == Instancing::Auto
+                        ? "auto on the CPU: traced flat, bit for bit (Embree instances may name another triangle "
+                          "at a copy's edges; --instancing on uses them)"
+                        : "the quads layout asked for: traced flat";
   return InstancingSummary{asked, used, why, scene.instances.size(), scene.prototypes.size(), f.instances,
                            f.prototypes, f.instances_left_flat, used ? f.flat_triangles : scene.triangles.size(),
                            uint64_t(std::max<int64_t>(0, embree.bytes())), embree.build_seconds()}

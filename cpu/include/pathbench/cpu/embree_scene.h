@@ -83,8 +83,8 @@ class EmbreeScene {
 // The Embree scene of `scene` in the layout asked for. Auto is resolved before the scene
 // is built (choose_embree_layout: measured once per scene per process), and the triangles
 // are paired at most once, shared by the layout probe and the scene.
-// With instancing (settings.h: use_instancing; Auto yields to an asked-for quads layout,
-// On with quads is an InputError) the instanced build.
+// With --instancing on (and instances in the scene; with quads an InputError) the
+// instanced build; Auto traces flat on the CPU (exact; embree_scene.cpp says why).
 std::unique_ptr<EmbreeScene> make_embree_scene(const Scene& scene, bool watertight,
                                                EmbreeLayout layout = EmbreeLayout::Auto,
                                                Instancing instancing = Instancing::Off);
