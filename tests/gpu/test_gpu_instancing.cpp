@@ -48,6 +48,7 @@ TEST(GpuInstancing, FilmsEqualFlatAndHost) {
     const GpuScene flat(scene, Instancing::Off), inst(scene, Instancing::On);
     for (Strategy strategy : {Strategy::Pixel, Strategy::Wavefront})
       for (Precision precision : {Precision::Float, Precision::Double}) {
+        if (strategy != Strategy::Pixel && precision == Precision::Double) continue;  // the GPU's double is pixel only
         SCOPED_TRACE(testing::Message() << name << " " << to_string(strategy) << " " << to_string(precision));
         RenderSettings s;
         s.width = 96;
