@@ -86,6 +86,7 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
     }
   }
   out.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.exact_ties = !scene.instances.empty();
   return out;
 }
 
@@ -110,6 +111,7 @@ BvhView SceneBvhHost::view() const {
       v.kind = TraversalKind::Binary;
       v.binary = binary.view();
   }
+  v.binary.exact_ties = v.wide.exact_ties = v.exact_ties = exact_ties ? 1u : 0u;
   return v;
 }
 

@@ -45,8 +45,9 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.view.emitter_cdf = m.emitter_cdf.get();
   // The host view with the device's pointers in place of the host's.
   m.bvh = bvh.view();
-  m.bvh.binary = {m.nodes.get(), m.tris.get(), uint32_t(m.nodes.size()), uint32_t(m.tris.size())};
-  m.bvh.wide = {m.wide_nodes.get(), m.tris.get(), uint32_t(m.wide_nodes.size()), uint32_t(m.tris.size())};
+  m.bvh.binary = {m.nodes.get(), m.tris.get(), uint32_t(m.nodes.size()), uint32_t(m.tris.size()), m.bvh.exact_ties};
+  m.bvh.wide = {m.wide_nodes.get(), m.tris.get(), uint32_t(m.wide_nodes.size()), uint32_t(m.tris.size()),
+                m.bvh.exact_ties};
   m.bvh.tris = m.tris.get();
   m.bvh.two_level = {m.top_nodes.get(), m.top_items.get(), m.instances.get(), m.bottom_nodes.get(),
                      m.bottom_items.get(), m.positions.get(), m.triangles.get()};

@@ -16,12 +16,12 @@ namespace pb::gpu {
 // lower id: detail::closer).
 template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse_all(const BvhTriangle* tris, uint32_t n, const Vec3f& o, const Vec3f& d, float t_max,
-                            float& t_hit, TraversalStats* stats = nullptr) {
+                            float& t_hit, TraversalStats* stats = nullptr, bool exact_ties = false) {
   const WatertightRay wr = make_watertight_ray(o, d);
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   for (uint32_t i = 0; i < n; ++i) {
-    if (detail::test_triangle<kWatertight>(tris, i, wr, o, d, t_max, t, hit, hit_slot, stats) && kAnyHit) {
+    if (detail::test_triangle<kWatertight>(tris, i, wr, o, d, t_max, exact_ties, t, hit, hit_slot, stats) && kAnyHit) {
       t_hit = t;
       return hit;
     }

@@ -62,6 +62,9 @@ struct SceneBvhHost {
   TwoLevelHost two_level;          // TwoLevel
   uint32_t binary_depth = 0, binary_leaves = 0;  // the binary BVH the wide one came from
   double binary_sah = 0, build_seconds = 0;
+  // The scene has instances: every traversal of it keeps the least (t, id) (bvh.h), so that
+  // its flat and two-level answers agree; set by build_scene_bvh, carried by view().
+  bool exact_ties = false;
 
   BvhView view() const;  // host pointers
   uint64_t bytes() const;

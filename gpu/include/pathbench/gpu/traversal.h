@@ -30,6 +30,7 @@ struct BvhView {
   WideBvhView wide{};
   const BvhTriangle* tris = nullptr;  // AllTriangles
   uint32_t num_tris = 0;
+  uint32_t exact_ties = 0;            // AllTriangles: as BinaryBvhView's
   TwoLevelView two_level{};
 };
 
@@ -43,7 +44,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
   if constexpr (kKind == int(TraversalKind::Wide)) {
     return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::AllTriangles)) {
-    return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats);
+    return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
   } else if constexpr (kKind == int(TraversalKind::Binary)) {
     return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::TwoLevel)) {
@@ -54,7 +55,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       case TraversalKind::TwoLevel:
         return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
       case TraversalKind::AllTriangles:
-        return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats);
+        return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
       default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
     }
   }

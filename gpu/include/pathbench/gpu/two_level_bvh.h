@@ -79,7 +79,7 @@ PB_HD uint32_t traverse_two_level(const TwoLevelView& v, const Vec3f& o, const V
           Vec3f a, b, c;
           detail::load_flat_triangle(v, tri, a, b, c);
           if (stats) ++stats->tris;
-          if (detail::test_vertices<kWatertight>(a, b, c, tri, wr, o, d, t_max, t, hit) && kAnyHit) return true;
+          if (detail::test_vertices<kWatertight>(a, b, c, tri, wr, o, d, t_max, true, t, hit) && kAnyHit) return true;
         }
         return false;
       };

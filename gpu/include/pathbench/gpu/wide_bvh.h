@@ -54,6 +54,7 @@ struct WideBvhView {
   const BvhTriangle* tris;
   uint32_t num_nodes;
   uint32_t num_tris;
+  uint32_t exact_ties = 0;  // as BinaryBvhView's
 };
 
 namespace detail {
@@ -212,7 +213,8 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       const uint32_t k = detail::lowest_bit(thits);
       thits &= thits - 1u;
       const uint32_t i = tbase + k;
-      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, t, hit, hit_slot, stats) && kAnyHit) {
+      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, bvh.exact_ties != 0, t, hit, hit_slot, stats) &&
+          kAnyHit) {
         t_hit = t;
         return hit;
       }
