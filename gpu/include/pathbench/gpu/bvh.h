@@ -240,54 +240,22 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
 template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
-  // The node loop of detail::walk_binary written out here, not called with a leaf lambda:
-  // the flat traversal is every kernel's hot loop, and the shared walk measured ~2 % slower
-  // in it on the H100 (gpu/NOTES.md); the two-level traversal uses walk_binary.
   const WatertightRay wr = make_watertight_ray(o, d);
-  const auto [inv, oi] = detail::make_slab_ray(o, d);
-  using detail::kFarScale;
-  const bool exact = bvh.exact_ties != 0;
-  uint32_t stack[kTraversalStackSize];
-  int sp = 0;
-  uint32_t ref = 0;
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
-  for (;;) {
-    while (!is_leaf(ref)) {
-      float x[4], y[4], z[4];
-      uint32_t child[2];
-      detail::load_node(bvh.nodes, ref, x, y, z, child);
-      if (stats) ++stats->nodes;
-      float tn[2], tf[2];
-      for (int c = 0; c < 2; ++c) {
-        const float tx0 = detail::fmadd(x[2 * c], inv.x, oi.x), tx1 = detail::fmadd(x[2 * c + 1], inv.x, oi.x);
-        const float ty0 = detail::fmadd(y[2 * c], inv.y, oi.y), ty1 = detail::fmadd(y[2 * c + 1], inv.y, oi.y);
-        const float tz0 = detail::fmadd(z[2 * c], inv.z, oi.z), tz1 = detail::fmadd(z[2 * c + 1], inv.z, oi.z);
-        tn[c] = pmax(pmax(pmin(tx0, tx1), pmin(ty0, ty1)), pmax(pmin(tz0, tz1), 0.0f));
-        tf[c] = pmin(pmin(pmax(tx0, tx1), pmax(ty0, ty1)), pmax(tz0, tz1)) * kFarScale;
-        tf[c] = pmin(tf[c], t);
-      }
-      const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
-      if (h0 && h1) {
-        const bool swap = tn[1] < tn[0];
-        ref = swap ? child[1] : child[0];
-        stack[sp++] = swap ? child[0] : child[1];
-      } else if (h0 || h1) {
-        ref = h0 ? child[0] : child[1];
-      } else {
-        if (sp == 0) return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
-        ref = stack[--sp];
-      }
-    }
-    const uint32_t first = leaf_first(ref), count = leaf_count(ref);
-    for (uint32_t i = first; i < first + count; ++i) {
-      if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, exact, t, hit, hit_slot, stats) && kAnyHit) {
-        t_hit = t;
-        return hit;
-      }
-    }
-    if (sp == 0) break;
-    ref = stack[--sp];
+  const bool stopped = detail::walk_binary(
+      bvh.nodes, o, d, t,
+      [&](uint32_t first, uint32_t count) {
+        for (uint32_t i = first; i < first + count; ++i)
+          if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, bvh.exact_ties != 0, t, hit, hit_slot, stats) &&
+              kAnyHit)
+            return true;
+        return false;
+      },
+      stats);
+  if (kAnyHit && stopped) {
+    t_hit = t;
+    return hit;
   }
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
