@@ -73,7 +73,28 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
   const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
+  // Shadow rays: the cull's scale, |o|_inf + tfar |d|_inf + the scene's largest
+  // coordinate (bounds |x| on the segment and |vertex - x|); lanes with tfar = inf are
+  // never culled (their scale is inf).
+  FV cull_scale{};
+  if constexpr (AnyHit) {
+    const FV dmax = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
+    cull_scale = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)) + tfar * dmax + s.pmax;
+  }
   for (const TinyScene::Triangle& tr : s.triangles) {
+    if constexpr (AnyHit) {
+      // The plane cull: a segment whose both ends lie on one side of the triangle's
+      // plane by more than the margin never reaches it, in Embree's arithmetic too (the
+      // margin, 2^-15 of the scale and more for slivers, is >= 16x the float error of
+      // this test plus Embree's T and its normal's rounding: cpu/NOTES.md). Skipped when
+      // that holds (or a hit is proven already) for every lane: far cheaper than the
+      // depth below for the walls of a closed box, which every shadow segment misses.
+      const FV s0 = fmadd(splat(tr.n[0]), o.x, fmadd(splat(tr.n[1]), o.y, fmsub(splat(tr.n[2]), o.z, splat(tr.c))));
+      const FV s1 = fmadd(tfar, emb_dot(V3{splat(tr.n[0]), splat(tr.n[1]), splat(tr.n[2])}, d), s0);
+      const FV mu = fmadd(cull_scale, splat(tr.cull_k), splat(tr.cull_rho));
+      const IV away = ((s0 > mu) & (s1 > mu)) | ((s0 < -mu) & (s1 < -mu));
+      if (lane_mask(~away & (r.best == inf)) == 0) continue;
+    }
     const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
     const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
     const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
