@@ -59,7 +59,7 @@ inline IV plane_away(const TinyScene::Triangle& tr, V3 o, V3 d, FV t_end, FV sca
   const V3 n{splat(tr.n[0]), splat(tr.n[1]), splat(tr.n[2])};
   const FV s0 = fmadd(n.x, o.x, fmadd(n.y, o.y, fmsub(n.z, o.z, splat(tr.c))));
   const FV s1 = fmadd(t_end, emb_dot(n, d), s0);
-  const FV mu = fmadd(scale, splat(tr.cull_k), splat(tr.cull_rho));
+  const FV mu = scale * tr.cull_k;
   return ((s0 > mu) & (s1 > mu)) | ((s0 < -mu) & (s1 < -mu));
 }
 
