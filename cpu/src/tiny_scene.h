@@ -38,7 +38,7 @@ struct TinyScene {
     float p[9];         // vertices v0, v1, v2 in Embree's order
     uint32_t triangle;  // the scene triangle
     float edge;         // its largest |edge component| (error bounds)
-    // Its plane, for the shadow rays' cull (tiny_x8.h): unit normal n and offset c
+    // Its plane, for the plane cull (tiny_x8.h `plane_away`): unit normal n and offset c
     // (n . x = c on the plane, both rounded to float), and the cull's margin per unit of
     // scale: 2^-15 (1 + 2 E^2 / |Ng|) (Embree's normal's rounding grows with E^2 / |Ng|,
     // a sliver's) plus the float plane's own miss of the vertices over pmax (the scale is
