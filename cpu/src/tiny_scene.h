@@ -34,13 +34,39 @@ struct TinyScene {
   // Embree's BVH is cheaper than testing them all (AVX2 measured between 14 and 34
   // triangles; AVX-512, whose test costs half per ray, estimated: cpu/NOTES.md).
   static constexpr int kTrianglesPerLane = 3;
-  struct Triangle {
+  struct alignas(64) Triangle {
     float p[9];         // vertices v0, v1, v2 in Embree's order
     uint32_t triangle;  // the scene triangle
     float edge;         // its largest |edge component| (error bounds)
+    // Its plane, for the plane cull (tiny_x8.h `plane_away`): unit normal n and offset c
+    // (n . x = c on the plane, both rounded to float), and the cull's margin per unit of
+    // scale: 2^-15 (1 + 2 E^2 / |Ng|) (Embree's normal's rounding grows with E^2 / |Ng|,
+    // a sliver's) plus the float plane's own miss of the vertices over pmax (the scale is
+    // >= pmax). k = inf: never culled. 16 floats: a table row is one cache line.
+    float n[3], c, cull_k;
   };
+  static_assert(sizeof(Triangle) == 64);
   std::vector<Triangle> triangles;
   float lo[3], hi[3];  // bounds of every vertex
+  float pmax;          // largest |vertex coordinate| (the cull's scale)
+
+  // r's plane in double, rounded to float; a degenerate triangle is never culled.
+  static void set_plane(Triangle& r, double pmax) {
+    double a[3], b[3], c[3];
+    for (int j = 0; j < 3; ++j) a[j] = r.p[j], b[j] = r.p[3 + j], c[j] = r.p[6 + j];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double ng[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const double len = std::sqrt(ng[0] * ng[0] + ng[1] * ng[1] + ng[2] * ng[2]);
+    r.n[0] = r.n[1] = r.n[2] = r.c = 0.0f;
+    r.cull_k = __builtin_inff();
+    if (!(len > 0.0) || !std::isfinite(len) || !(pmax > 0.0)) return;
+    for (int j = 0; j < 3; ++j) r.n[j] = float(ng[j] / len);
+    r.c = float(double(r.n[0]) * a[0] + double(r.n[1]) * a[1] + double(r.n[2]) * a[2]);
+    double rho = 0.0;
+    for (const double* q : {a, b, c})
+      rho = std::max(rho, std::fabs(double(r.n[0]) * q[0] + double(r.n[1]) * q[1] + double(r.n[2]) * q[2] - double(r.c)));
+    r.cull_k = float(0x1p-15 * (1.0 + 2.0 * double(r.edge) * double(r.edge) / len) + (2.0 * rho + 0x1p-30) / pmax);
+  }
 
   // The table for the Embree scene `e` of `s`, or null where it has more than
   // `max_triangles`.
@@ -78,6 +104,9 @@ struct TinyScene {
           t->hi[j] = std::max(t->hi[j], r.p[3 * i + j]);
         }
     }
+    t->pmax = 0.0f;
+    for (int j = 0; j < 3; ++j) t->pmax = std::max({t->pmax, std::fabs(t->lo[j]), std::fabs(t->hi[j])});
+    for (Triangle& r : t->triangles) set_plane(r, t->pmax);
     return t;
   }
 };

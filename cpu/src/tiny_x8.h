@@ -49,6 +49,20 @@ inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
           select(abs(ab_z) < abs(bc_z), cab.z, cbc.z)};
 }
 
+// The plane cull: a segment [0, t_end] whose both ends lie on one side of the triangle's
+// plane by more than the margin never reaches it, in Embree's arithmetic too (the margin,
+// 2^-15 of `scale` and more for slivers, is >= 16x the float error of this test plus
+// Embree's T, den and its normal's rounding: cpu/NOTES.md). Far cheaper than the depth or
+// the edges for the walls of a closed box, which every shadow segment, and every segment
+// up to a found hit, misses.
+inline IV plane_away(const TinyScene::Triangle& tr, V3 o, V3 d, FV t_end, FV scale) {
+  const V3 n{splat(tr.n[0]), splat(tr.n[1]), splat(tr.n[2])};
+  const FV s0 = fmadd(n.x, o.x, fmadd(n.y, o.y, fmsub(n.z, o.z, splat(tr.c))));
+  const FV s1 = fmadd(t_end, emb_dot(n, d), s0);
+  const FV mu = scale * tr.cull_k;
+  return ((s0 > mu) & (s1 > mu)) | ((s0 < -mu) & (s1 < -mu));
+}
+
 struct TinyResult {
   FV best, best_err;  // nearest proven hit's distance and its error (0 while there is none)
   FV other_lo;       // lowest bottom of any other proven hit's or doubt's interval
@@ -73,7 +87,22 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
   const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
+  // The plane cull's scale (below): |o|_inf + t_end |d|_inf + the scene's largest
+  // coordinate bounds |x| on the segment and |vertex - x|. Shadow rays: t_end = tfar
+  // (inf: never culled). Closest hits: once every lane has a proven hit, t_end = its far
+  // end, best + err: a triangle the segment misses is farther than the hit in Embree's
+  // arithmetic too, and clear of its interval.
+  const FV dmax = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
+  const FV cull_base = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)) + s.pmax;
+  const FV shadow_scale = fmadd(tfar, dmax, cull_base);
   for (const TinyScene::Triangle& tr : s.triangles) {
+    if constexpr (AnyHit) {
+      // Skipped where every lane is away or blocked already.
+      if (lane_mask(~plane_away(tr, o, d, tfar, shadow_scale) & (r.best == inf)) == 0) continue;
+    } else if (lane_mask(r.best == inf) == 0) {
+      const FV t_end = r.best + r.best_err;
+      if (lane_mask(~plane_away(tr, o, d, t_end, fmadd(t_end, dmax, cull_base))) == 0) continue;
+    }
     const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
     const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
     const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
