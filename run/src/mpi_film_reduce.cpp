@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <climits>
 #include <stdexcept>
-#include <type_traits>
 #include <vector>
 
 #include <fmt/core.h>
 
 #include "mpi_detail.h"
+#include "pathbench/run/ranks.h"
 #include "pathbench/run/world.h"
 
 namespace pb::run {
@@ -56,11 +56,7 @@ template <class T> void receive_add(T* into, size_t n, MPI_Datatype type, int fr
     const size_t m = std::min(kRowPiece, n - at);
     buf.resize(m);
     MPI_Recv(buf.data(), int(m), type, from, kRowsTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    T* dst = into + at;
-    for (size_t i = 0; i < m; ++i) {
-      if constexpr (std::is_integral_v<T>) ok &= !__builtin_add_overflow(dst[i], buf[i], &dst[i]);
-      else dst[i] += buf[i];
-    }
+    ok &= add_values(into + at, buf.data(), m);
   }
 }
 }  // namespace

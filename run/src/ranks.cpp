@@ -68,15 +68,9 @@ bool add_rows_into(Film& into, uint32_t first_row, uint32_t rows, const int64_t*
                    const double* sum_sq) {
   if (uint64_t(first_row) + rows > into.height()) throw std::invalid_argument("add_rows_into: rows outside the film");
   const size_t px0 = size_t(first_row) * into.width(), px = size_t(rows) * into.width();
-  bool ok = true;
-  int64_t* sum = into.raw_sums().data() + px0 * 3;
-  for (size_t i = 0; i < px * 3; ++i) ok &= !__builtin_add_overflow(sum[i], sums[i], &sum[i]);
-  uint32_t* count = into.counts().data() + px0;
-  for (size_t i = 0; i < px; ++i) ok &= !__builtin_add_overflow(count[i], counts[i], &count[i]);
-  if (into.has_variance() && sum_sq) {
-    double* sq = into.raw_sum_sq().data() + px0 * 3;
-    for (size_t i = 0; i < px * 3; ++i) sq[i] += sum_sq[i];
-  }
+  bool ok = add_values(into.raw_sums().data() + px0 * 3, sums, px * 3);
+  ok &= add_values(into.counts().data() + px0, counts, px);
+  if (into.has_variance() && sum_sq) add_values(into.raw_sum_sq().data() + px0 * 3, sum_sq, px * 3);
   return ok;
 }
 

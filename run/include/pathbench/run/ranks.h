@@ -2,7 +2,9 @@
 // What the run layer will hand each MPI rank (issue 13), kept apart from MPI itself so
 // that it is tested in every build: a rank's share of each pixel's samples, and the
 // exact reduction of the rank films' integer sums.
+#include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "pathbench/common/film.h"
@@ -43,6 +45,18 @@ struct RowRange {
 };
 // Adds `block`'s rows to `rows` (sorted, merged where they touch or overlap).
 void add_rows(std::vector<RowRange>& rows, const FrameBlock& block);
+
+// into[i] += add[i] for i < n: integers checked (false where one overflowed, the rest
+// still added), doubles (variance sums) summed. The one addition of rank films' values:
+// add_rows_into, reduce_film and World::reduce_film_rows use it.
+template <class T> bool add_values(T* into, const T* add, size_t n) {
+  bool ok = true;
+  for (size_t i = 0; i < n; ++i) {
+    if constexpr (std::is_integral_v<T>) ok &= !__builtin_add_overflow(into[i], add[i], &into[i]);
+    else into[i] += add[i];
+  }
+  return ok;
+}
 
 // Adds `part`'s sums, counts and variance sums into `into` (same size, same scale: both
 // begun for the whole frame). Integer sums: exact and order-free. Throws
