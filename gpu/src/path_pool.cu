@@ -1,7 +1,6 @@
-// The wavefront and paper-queue strategies' frame loop: the first plan, then intersect,
-// shade and shadow (whose last block plans the next iteration) launched in turn on one
-// stream (no host wait between them), the counters read back every few iterations to
-// see whether the frame is done.
+// The wavefront and paper-queue strategies' frame loop: schedule, intersect, shade and
+// shadow launched in turn on one stream (no host wait between them), the
+// counters read back every few iterations to see whether the frame is done.
 #include "path_pool.cuh"
 
 #include "wavefront_stages.cuh"
@@ -16,26 +15,22 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   const uint32_t cap = uint32_t(capacity_);
   FrameResult r;
   constexpr int kCheckEvery = 4;  // iterations between looks at the counters
-  const NextPlan plan{static_cast<unsigned long long>(total), cap};
-  const bool shade_plans = !shadows_.records;  // else the shadow kernel, the iteration's last
-  launch.launch("schedule", k_wf_schedule, 1, ctr, plan.total, cap);
   for (uint64_t it = 0;; ++it) {
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
+    launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
     with_traversal_kind(g.bvh.kind, [&](auto kind) {  // intersect compiled for the BVH layout
       launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, spp);
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;
-      if (variance)
-        launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp, plan, shade_plans);
-      else
-        launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp, plan, shade_plans);
+      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp);
+      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp);
     });
     if (shadows_.records) {
       with_traversal_kind(g.bvh.kind, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
-        if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, film, plan);
-        else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, film, plan);
+        if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, film);
+        else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, film);
       });
     }
     if (it % kCheckEvery == kCheckEvery - 1) {
@@ -47,7 +42,7 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
       }
     }
   }
-  // Each iteration's last kernel booked it; every generated path has ended.
+  // The last schedule booked every iteration; every generated path has ended.
   r.stats = host_ctr_->stats;
   r.stats.paths = r.stats.camera;
   r.state_bytes_per_path = state_bytes(shadows_);

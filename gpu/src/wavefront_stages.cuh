@@ -1,6 +1,6 @@
 #pragma once
-// The wavefront's stage kernels, one per stage: schedule (the frame's first plan; later
-// ones are made by the last block of each iteration's last kernel), intersect (closest hit; new samples' camera rays made
+// The wavefront's stage kernels, one per stage: schedule (book the last iteration, plan
+// the refill with new samples), intersect (closest hit; new samples' camera rays made
 // there and again in shade, never stored), shade (the shared path
 // step; continuing paths compacted into the next buffer, shadow rays queued) and shadow
 // (occlusion, then radiance to the film or the continuing path). Launched by PathPool
@@ -16,11 +16,11 @@
 namespace pb::gpu {
 namespace {
 
-// Books the iteration that just ended (its continuing paths and shadow rays) and plans
-// the next one's refill: new samples take the indices after the continuing paths.
-// Run by one thread once every other thread of the iteration's last kernel is done.
-__device__ __forceinline__ void plan_next_iteration(volatile WaveCounters& c, unsigned long long total,
-                                                    uint32_t capacity) {
+// One thread: books the last iteration and plans this one's refill.
+__global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint32_t capacity) {
+  kernel_prologue();
+  if (grid_thread() != 0) return;
+  WaveCounters& c = *ctr;
   const uint32_t cont = c.n_next;  // paths that continued from the last shade
   c.stats.bounce += cont;
   c.stats.shadow += c.n_shadow;
@@ -36,36 +36,6 @@ __device__ __forceinline__ void plan_next_iteration(volatile WaveCounters& c, un
   c.n_next = 0;
   c.n_shadow = 0;
   c.live = c.n_cur;
-}
-
-// The frame's first plan (one thread); later plans are made at the end of each
-// iteration's last kernel (plan_if_last_block), which saves a launch an iteration.
-__global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint32_t capacity) {
-  kernel_prologue();
-  if (grid_thread() == 0) plan_next_iteration(*ctr, total, capacity);
-}
-
-// Where the next iteration is planned: in the last kernel of this one (shadow, or shade
-// when there are no shadow rays), by its last block to finish.
-struct NextPlan {
-  unsigned long long total;  // samples in the frame
-  uint32_t capacity;         // paths a buffer holds
-};
-
-// Every thread of the kernel calls this at its end, after its last read of the
-// counters. The block that finishes last (a counter of finished blocks, the classic
-// threadfence pattern) plans the next iteration; by then every other block has read
-// n_cur / n_shadow / gen_* and made its appends, so nothing reads a field it resets.
-__device__ __forceinline__ void plan_if_last_block(WaveCounters* ctr, const NextPlan& plan) {
-  __syncthreads();
-  if (threadIdx.x == 0) {
-    __threadfence();  // this block's appends and stats are visible before it counts itself done
-    if (atomicAdd(&ctr->blocks_done, 1u) == gridDim.x - 1) {
-      __threadfence();
-      plan_next_iteration(*ctr, plan.total, plan.capacity);
-      ctr->blocks_done = 0;
-    }
-  }
 }
 
 // This iteration's new samples: indices [gen_dst, n_cur) of the current buffer, after
@@ -129,7 +99,7 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
 template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film,
-                                                     uint32_t spp, NextPlan plan, bool plans_next) {
+                                                     uint32_t spp) {
   kernel_prologue();
   const uint32_t n = ctr->n_cur;
   const NewPaths fresh = new_paths(ctr, spp);
@@ -184,12 +154,11 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
     const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
     if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
   }
-  if (plans_next) plan_if_last_block(ctr, plan);  // no shadow kernel follows
 }
 
 template <bool kVariance, int kKind>
 __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
-                                                      FilmDev film, NextPlan plan) {
+                                                      FilmDev film) {
   kernel_prologue();
   const uint32_t n = ctr->n_shadow;
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
@@ -225,7 +194,6 @@ __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_shadow
     }
     film_add_warp<kVariance>(film, add, pixel, L, &ctr->stats.discarded);
   }
-  plan_if_last_block(ctr, plan);
 }
 
 }  // namespace

@@ -45,7 +45,6 @@ struct WaveCounters {
   uint32_t n_shadow;   // shadow rays queued this iteration
   uint32_t gen_count, gen_dst;
   uint32_t live;       // == n_cur after scheduling; 0: the frame is done
-  uint32_t blocks_done;  // blocks of the iteration's last kernel that finished (plan_if_last_block)
   unsigned long long next_sample, gen_base;
   Stats stats;
 };
