@@ -1,6 +1,6 @@
-// The wavefront and paper-queue strategies' frame loop: schedule, intersect, shade and
-// shadow launched in turn on one stream (no host wait between them), the
-// counters read back every few iterations to see whether the frame is done.
+// The wavefront and paper-queue strategies' frame loop: intersect (which plans the
+// iteration), shade and shadow launched in turn on one stream (no host wait between
+// them), the counters read back every few iterations to see whether the frame is done.
 #include "path_pool.cuh"
 
 #include "wavefront_stages.cuh"
@@ -17,32 +17,34 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   constexpr int kCheckEvery = 4;  // iterations between looks at the counters
   for (uint64_t it = 0;; ++it) {
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
-    launch.launch("schedule", k_wf_schedule, 1, ctr, static_cast<unsigned long long>(total), cap);
+    const uint32_t parity = uint32_t(it & 1);
+    const WaveStep step{parity, static_cast<unsigned long long>(total), cap};
     with_traversal_kind(g.bvh.kind, [&](auto kind) {  // intersect compiled for the BVH layout
-      launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, spp);
+      launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, step, spp);
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;
-      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp);
-      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, film, spp);
+      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
+      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
     });
     if (shadows_.records) {
       with_traversal_kind(g.bvh.kind, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
-        if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, film);
-        else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, film);
+        if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, parity, film);
+        else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, parity, film);
       });
     }
     if (it % kCheckEvery == kCheckEvery - 1) {
       PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
       PB_CUDA_CHECK(cudaStreamSynchronize(stream));
-      if (host_ctr_->live == 0 && host_ctr_->next_sample >= total) {
+      // An iteration planned with nothing to trace: no path continued, no sample is left.
+      if (host_ctr_->it[parity].n_cur == 0) {
         r.iterations = it + 1;
         break;
       }
     }
   }
-  // The last schedule booked every iteration; every generated path has ended.
+  // The empty iteration's intersect booked every one before it; every path has ended.
   r.stats = host_ctr_->stats;
   r.stats.paths = r.stats.camera;
   r.state_bytes_per_path = state_bytes(shadows_);

@@ -1,7 +1,7 @@
 #pragma once
-// The wavefront's stage kernels, one per stage: schedule (book the last iteration, plan
-// the refill with new samples), intersect (closest hit; new samples' camera rays made
-// there and again in shade, never stored), shade (the shared path
+// The wavefront's stage kernels, one per stage: intersect (plans the iteration from the
+// one before: the refill with new samples; then the closest hits, new samples' camera
+// rays made there and again in shade, never stored), shade (the shared path
 // step; continuing paths compacted into the next buffer, shadow rays queued) and shadow
 // (occlusion, then radiance to the film or the continuing path). Launched by PathPool
 // (path_pool.cu, the only includer).
@@ -16,27 +16,40 @@
 namespace pb::gpu {
 namespace {
 
-// One thread: books the last iteration and plans this one's refill.
-__global__ void k_wf_schedule(WaveCounters* ctr, unsigned long long total, uint32_t capacity) {
-  kernel_prologue();
-  if (grid_thread() != 0) return;
-  WaveCounters& c = *ctr;
-  const uint32_t cont = c.n_next;  // paths that continued from the last shade
-  c.stats.bounce += cont;
-  c.stats.shadow += c.n_shadow;
-  const unsigned long long remaining = total - c.next_sample;
+// This iteration's plan, from the one before (`prev`, complete: its kernels are done):
+// the paths that continued, then as many new samples as fit. Every intersect thread
+// computes it (a few uniform loads), so no launch between iterations is needed.
+struct IterationPlan {
+  uint32_t n_cur, gen_dst;
+  unsigned long long gen_base, next_after;
+};
+
+__device__ __forceinline__ IterationPlan plan_iteration(const IterationCounters& prev, unsigned long long total,
+                                                        uint32_t capacity) {
+  const uint32_t cont = prev.n_next;
+  const unsigned long long remaining = total - prev.next_after;
   const uint32_t room = capacity - cont;
   const uint32_t n = uint32_t(remaining < room ? remaining : room);
-  c.gen_count = n;
-  c.gen_dst = cont;
-  c.gen_base = c.next_sample;
-  c.next_sample += n;
-  c.stats.camera += n;
-  c.n_cur = cont + n;
-  c.n_next = 0;
-  c.n_shadow = 0;
-  c.live = c.n_cur;
+  return {cont + n, cont, prev.next_after, prev.next_after + n};
 }
+
+// Thread 0 of the intersect kernel: records the plan for shade and shadow (and the host)
+// and books the iteration before into the stats. The record it overwrites was last used
+// two iterations ago; the stats are touched by no other kernel while intersect runs.
+__device__ __forceinline__ void record_plan(WaveCounters* ctr, uint32_t parity, const IterationPlan& plan) {
+  const IterationCounters& prev = ctr->it[parity ^ 1u];
+  ctr->stats.bounce += prev.n_next;
+  ctr->stats.shadow += prev.n_shadow;
+  ctr->stats.camera += plan.n_cur - plan.gen_dst;
+  ctr->it[parity] = {plan.n_cur, plan.gen_dst, 0u, 0u, plan.gen_base, plan.next_after};
+}
+
+// Where the wavefront is: the iteration's parity and what planning needs.
+struct WaveStep {
+  uint32_t parity;           // iteration & 1: which IterationCounters is this iteration's
+  unsigned long long total;  // samples in the frame
+  uint32_t capacity;         // paths a buffer holds
+};
 
 // This iteration's new samples: indices [gen_dst, n_cur) of the current buffer, after
 // the continuing paths; a warp takes consecutive samples of a pixel, as the pixel
@@ -49,10 +62,6 @@ struct NewPaths {
   uint32_t spp;
 };
 
-__device__ __forceinline__ NewPaths new_paths(const WaveCounters* ctr, uint32_t spp) {
-  return {ctr->gen_dst, ctr->gen_base, spp};
-}
-
 __device__ __forceinline__ PathState<float> current_path(const SceneView& s, const PathConfig& c, const PathSoA& cur,
                                                          const NewPaths& fresh, uint32_t i) {
   if (i < fresh.dst) return load_path(cur, i);
@@ -62,18 +71,17 @@ __device__ __forceinline__ PathState<float> current_path(const SceneView& s, con
   return st;
 }
 
-// Blocks an SM for the traversal stages: 5 (48 registers) suits the binary and brute-force
-// traversals; the wide one holds a node's 20 words and spills under 48 (ptxas: 28 B in
-// intersect, 100 B in shadow), so it gets 4 (64 registers).
 template <int kKind>
 constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
 
 template <int kKind>  // the BVH layout (traversal.h)
 __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_intersect(SceneView s, PathConfig c, BvhView bvh, PathSoA cur, uint32_t* prim,
-                                                                                     const WaveCounters* ctr, uint32_t spp) {
+                                                                                     WaveCounters* ctr, WaveStep step, uint32_t spp) {
   kernel_prologue();
-  const uint32_t n = ctr->n_cur;
-  const NewPaths fresh = new_paths(ctr, spp);
+  const IterationPlan plan = plan_iteration(ctr->it[step.parity ^ 1u], step.total, step.capacity);
+  if (grid_thread() == 0) record_plan(ctr, step.parity, plan);
+  const uint32_t n = plan.n_cur;
+  const NewPaths fresh{plan.gen_dst, plan.gen_base, spp};
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
     Vec3f o, d;
     if (i < fresh.dst) {
@@ -98,11 +106,12 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
 
 template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
-                                                     const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, FilmDev film,
-                                                     uint32_t spp) {
+                                                     const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, uint32_t parity,
+                                                     FilmDev film, uint32_t spp) {
   kernel_prologue();
-  const uint32_t n = ctr->n_cur;
-  const NewPaths fresh = new_paths(ctr, spp);
+  IterationCounters& at = ctr->it[parity];
+  const uint32_t n = at.n_cur;
+  const NewPaths fresh{at.gen_dst, at.gen_base, spp};
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
     const uint32_t i = base + lane;
@@ -129,14 +138,14 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
         }
         uint32_t target = kShadowDone | st.pixel;
         if (ev == PathEvent::Continue) {
-          const uint32_t j = queue_push(&ctr->n_next);
+          const uint32_t j = queue_push(&at.n_next);
           store_path(next, j, st);
           target = j;
         }
         if (wants_shadow || final_ray) {
           // Light-sampling ray first (shadow_unoccluded's order in trace_path); both
           // rays of a pair leave from the same origin (the offset hit point).
-          const uint32_t k = queue_push(&ctr->n_shadow);
+          const uint32_t k = queue_push(&at.n_shadow);
           push_shadow(sh, k, wants_shadow ? q : fq, target);
           pair = wants_shadow && final_ray;
           if (pair) {
@@ -158,9 +167,9 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
 
 template <bool kVariance, int kKind>
 __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
-                                                      FilmDev film) {
+                                                      uint32_t parity, FilmDev film) {
   kernel_prologue();
-  const uint32_t n = ctr->n_shadow;
+  const uint32_t n = ctr->it[parity].n_shadow;
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
     const uint32_t i = base + lane;

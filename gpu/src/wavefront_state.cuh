@@ -39,15 +39,24 @@ struct ShadowSoA {
 };
 constexpr uint32_t kShadowDone = 0x80000000u;  // pixels < 2^31 (RenderSettings::validate)
 
-struct WaveCounters {
-  uint32_t n_cur;      // paths to trace this iteration
-  uint32_t n_next;     // paths continued into the next buffer
-  uint32_t n_shadow;   // shadow rays queued this iteration
-  uint32_t gen_count, gen_dst;
-  uint32_t live;       // == n_cur after scheduling; 0: the frame is done
-  unsigned long long next_sample, gen_base;
-  Stats stats;
+// One iteration's plan and appends. Two alternate (iteration i uses it[i & 1]): the
+// intersect kernel of iteration i plans it from it[(i + 1) & 1], the iteration before,
+// which nobody writes any more, while it[i & 1], last used two iterations ago, is free
+// to be reset. So no kernel of its own and no grid-wide barrier is needed to plan.
+struct IterationCounters {
+  uint32_t n_cur;     // paths traced this iteration: continuing ones, then new samples
+  uint32_t gen_dst;   // index of the first new sample's path (= continuing paths)
+  uint32_t n_next;    // paths continued into the next buffer (appends)
+  uint32_t n_shadow;  // shadow rays queued (appends)
+  unsigned long long gen_base;    // the first new sample's index in the frame
+  unsigned long long next_after;  // samples handed out up to and including this iteration
 };
+
+struct WaveCounters {
+  IterationCounters it[2];
+  Stats stats;  // booked by the planning thread, plus the kernels' atomics
+};
+
 
 
 // Warp-aggregated append: one atomic per warp.
