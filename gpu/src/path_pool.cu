@@ -14,7 +14,14 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   WaveCounters* ctr = ctr_.get();
   const uint32_t cap = uint32_t(capacity_);
   FrameResult r;
-  constexpr int kCheckEvery = 4;  // iterations between looks at the counters
+  // Every kCheckEvery iterations the counters are copied to the host; the host then reads
+  // the copy of the look before, kCheckEvery iterations older, which the GPU has long
+  // finished: the host stays that far ahead and the GPU never idles while the host waits
+  // (a synchronous look drained the queue 20 times a paper frame). The price: up to
+  // 2 kCheckEvery - 1 iterations after the last, whose kernels find nothing to do.
+  constexpr int kCheckEvery = 4;
+  uint64_t looks = 0;
+  const WaveCounters* last = nullptr;  // the copy that saw the frame done
   for (uint64_t it = 0;; ++it) {
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     const uint32_t parity = uint32_t(it & 1);
@@ -35,17 +42,23 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
       });
     }
     if (it % kCheckEvery == kCheckEvery - 1) {
-      PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
-      PB_CUDA_CHECK(cudaStreamSynchronize(stream));
-      // An iteration planned with nothing to trace: no path continued, no sample is left.
-      if (host_ctr_->it[parity].n_cur == 0) {
-        r.iterations = it + 1;
-        break;
+      const int b = int(looks & 1);
+      PB_CUDA_CHECK(cudaMemcpyAsync(&host_ctr_[b], ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
+      PB_CUDA_CHECK(cudaEventRecord(looked_[b], stream));
+      if (looks++ > 0) {  // the look before: iteration it - kCheckEvery
+        PB_CUDA_CHECK(cudaEventSynchronize(looked_[b ^ 1]));
+        const uint64_t seen = it - kCheckEvery;
+        // An iteration planned with nothing to trace: no path continued, no sample is left.
+        if (host_ctr_[b ^ 1].it[seen & 1].n_cur == 0) {
+          r.iterations = seen + 1;
+          last = &host_ctr_[b ^ 1];
+          break;
+        }
       }
     }
   }
   // The empty iteration's intersect booked every one before it; every path has ended.
-  r.stats = host_ctr_->stats;
+  r.stats = last->stats;
   r.stats.paths = r.stats.camera;
   r.state_bytes_per_path = state_bytes(shadows_);
   r.paths_in_flight = capacity_;

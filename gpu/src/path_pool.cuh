@@ -32,9 +32,14 @@ class PathPool {
       sh_c2_.allocate(capacity, what, lower);
     }
     ctr_.allocate(1, what, lower);
-    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(WaveCounters)));
+    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, 2 * sizeof(WaveCounters)));
+    for (auto& e : looked_) PB_CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
   }
-  ~PathPool() { if (host_ctr_) cudaFreeHost(host_ctr_); }
+  ~PathPool() {
+    for (auto& e : looked_)
+      if (e) cudaEventDestroy(e);
+    if (host_ctr_) cudaFreeHost(host_ctr_);
+  }
   PathPool(const PathPool&) = delete;
   PathPool& operator=(const PathPool&) = delete;
 
@@ -69,7 +74,8 @@ class PathPool {
   DeviceBuffer<float4> sh_o_, sh_d_, sh_L_, sh_d2_;
   DeviceBuffer<float2> sh_ct_, sh_c2_;
   DeviceBuffer<WaveCounters> ctr_;
-  WaveCounters* host_ctr_ = nullptr;
+  WaveCounters* host_ctr_ = nullptr;  // two copies of the counters: the last two looks (run)
+  cudaEvent_t looked_[2] = {nullptr, nullptr};  // each copy's arrival
 };
 
 }  // namespace pb::gpu
