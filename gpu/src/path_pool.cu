@@ -1,11 +1,34 @@
 // The wavefront and paper-queue strategies' frame loop: intersect (which plans the
 // iteration), shade and shadow launched in turn on one stream (no host wait between
-// them), the counters read back every few iterations to see whether the frame is done.
+// them); whether the frame is done is read from mapped host memory the kernels write.
 #include "path_pool.cuh"
+
+#include <stdexcept>
+#include <thread>
 
 #include "wavefront_stages.cuh"
 
 namespace pb::gpu {
+
+namespace {
+
+// What an intersect kernel wrote into `slot` (mapped host memory: 1 if its iteration has
+// paths, 0 if not), waiting for the GPU to get there; a failure in the stream is reported instead of waiting forever.
+uint32_t wait_for_plan(cudaStream_t stream, const uint32_t& slot) {
+  const volatile uint32_t& v = slot;
+  for (uint32_t spins = 0;; ++spins) {
+    if (v != kNotPlanned) return v;
+    if (spins % 1024 == 1023) {
+      const cudaError_t e = cudaStreamQuery(stream);
+      if (e == cudaSuccess && v == kNotPlanned)
+        throw std::logic_error("wavefront: the stream drained but the iteration's plan never arrived");
+      if (e != cudaSuccess && e != cudaErrorNotReady) PB_CUDA_CHECK(e);
+      std::this_thread::yield();
+    }
+  }
+}
+
+}  // namespace
 
 FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                           uint64_t total, FilmDev film, bool variance) {
@@ -14,18 +37,18 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   WaveCounters* ctr = ctr_.get();
   const uint32_t cap = uint32_t(capacity_);
   FrameResult r;
-  // Every kCheckEvery iterations the counters are copied to the host; the host then reads
-  // the copy of the look before, kCheckEvery iterations older, which the GPU has long
-  // finished: the host stays that far ahead and the GPU never idles while the host waits
-  // (a synchronous look drained the queue 20 times a paper frame). The price: up to
-  // 2 kCheckEvery - 1 iterations after the last, whose kernels find nothing to do.
-  constexpr int kCheckEvery = 4;
-  uint64_t looks = 0;
-  const WaveCounters* last = nullptr;  // the copy that saw the frame done
+  // Whether the frame is done is read from the plans the intersect kernels write into
+  // mapped host memory: no copy or synchronisation in the stream, so the GPU never
+  // idles while the host looks (a synchronous look every 4 iterations drained the queue
+  // 20 times a paper frame). The host stays kLag iterations ahead of what it reads, so
+  // up to kLag empty iterations (kernels that find nothing to do) follow the last.
+  constexpr uint64_t kLag = 3;
+  static_assert(kLag < kPlanSlots, "a slot is read and reset before the GPU reaches it again");
+  for (int k = 0; k < kPlanSlots; ++k) planned_[k] = kNotPlanned;
   for (uint64_t it = 0;; ++it) {
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     const uint32_t parity = uint32_t(it & 1);
-    const WaveStep step{parity, static_cast<unsigned long long>(total), cap};
+    const WaveStep step{parity, static_cast<unsigned long long>(total), cap, &planned_[it % kPlanSlots]};
     with_traversal_kind(g.bvh.kind, [&](auto kind) {  // intersect compiled for the BVH layout
       launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, step, spp);
     });
@@ -41,24 +64,20 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
         else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, parity, film);
       });
     }
-    if (it % kCheckEvery == kCheckEvery - 1) {
-      const int b = int(looks & 1);
-      PB_CUDA_CHECK(cudaMemcpyAsync(&host_ctr_[b], ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
-      PB_CUDA_CHECK(cudaEventRecord(looked_[b], stream));
-      if (looks++ > 0) {  // the look before: iteration it - kCheckEvery
-        PB_CUDA_CHECK(cudaEventSynchronize(looked_[b ^ 1]));
-        const uint64_t seen = it - kCheckEvery;
-        // An iteration planned with nothing to trace: no path continued, no sample is left.
-        if (host_ctr_[b ^ 1].it[seen & 1].n_cur == 0) {
-          r.iterations = seen + 1;
-          last = &host_ctr_[b ^ 1];
-          break;
-        }
+    if (it >= kLag) {
+      const uint64_t seen = it - kLag;
+      const uint32_t has_paths = wait_for_plan(stream, planned_[seen % kPlanSlots]);
+      planned_[seen % kPlanSlots] = kNotPlanned;
+      if (!has_paths) {  // an iteration with nothing to trace: no path continued, no sample is left
+        r.iterations = seen + 1;
+        break;
       }
     }
   }
   // The empty iteration's intersect booked every one before it; every path has ended.
-  r.stats = last->stats;
+  PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
+  PB_CUDA_CHECK(cudaStreamSynchronize(stream));
+  r.stats = host_ctr_->stats;
   r.stats.paths = r.stats.camera;
   r.state_bytes_per_path = state_bytes(shadows_);
   r.paths_in_flight = capacity_;

@@ -32,12 +32,11 @@ class PathPool {
       sh_c2_.allocate(capacity, what, lower);
     }
     ctr_.allocate(1, what, lower);
-    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, 2 * sizeof(WaveCounters)));
-    for (auto& e : looked_) PB_CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
+    PB_CUDA_CHECK(cudaMallocHost(&host_ctr_, sizeof(WaveCounters)));
+    PB_CUDA_CHECK(cudaHostAlloc(&planned_, kPlanSlots * sizeof(uint32_t), cudaHostAllocMapped));
   }
   ~PathPool() {
-    for (auto& e : looked_)
-      if (e) cudaEventDestroy(e);
+    if (planned_) cudaFreeHost(planned_);
     if (host_ctr_) cudaFreeHost(host_ctr_);
   }
   PathPool(const PathPool&) = delete;
@@ -74,8 +73,11 @@ class PathPool {
   DeviceBuffer<float4> sh_o_, sh_d_, sh_L_, sh_d2_;
   DeviceBuffer<float2> sh_ct_, sh_c2_;
   DeviceBuffer<WaveCounters> ctr_;
-  WaveCounters* host_ctr_ = nullptr;  // two copies of the counters: the last two looks (run)
-  cudaEvent_t looked_[2] = {nullptr, nullptr};  // each copy's arrival
+  WaveCounters* host_ctr_ = nullptr;  // the counters at the end of a frame
+  // Mapped host memory: iteration i's intersect writes into slot i % kPlanSlots whether it
+  // has paths to trace (run reads them while the GPU works, resets them to kNotPlanned).
+  static constexpr int kPlanSlots = 8;
+  uint32_t* planned_ = nullptr;
 };
 
 }  // namespace pb::gpu

@@ -49,6 +49,7 @@ struct WaveStep {
   uint32_t parity;           // iteration & 1: which IterationCounters is this iteration's
   unsigned long long total;  // samples in the frame
   uint32_t capacity;         // paths a buffer holds
+  uint32_t* planned;         // mapped host memory: 1 if this iteration has paths to trace, else 0
 };
 
 // This iteration's new samples: indices [gen_dst, n_cur) of the current buffer, after
@@ -79,7 +80,11 @@ __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_inters
                                                                                      WaveCounters* ctr, WaveStep step, uint32_t spp) {
   kernel_prologue();
   const IterationPlan plan = plan_iteration(ctr->it[step.parity ^ 1u], step.total, step.capacity);
-  if (grid_thread() == 0) record_plan(ctr, step.parity, plan);
+  if (grid_thread() == 0) {
+    record_plan(ctr, step.parity, plan);
+    *reinterpret_cast<volatile uint32_t*>(step.planned) = plan.n_cur != 0;  // for the host's loop
+    __threadfence_system();
+  }
   const uint32_t n = plan.n_cur;
   const NewPaths fresh{plan.gen_dst, plan.gen_base, spp};
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {

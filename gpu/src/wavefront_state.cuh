@@ -52,6 +52,8 @@ struct IterationCounters {
   unsigned long long next_after;  // samples handed out up to and including this iteration
 };
 
+constexpr uint32_t kNotPlanned = 0xFFFFFFFFu;  // a plan slot the GPU has not written yet (PathPool)
+
 struct WaveCounters {
   IterationCounters it[2];
   Stats stats;  // booked by the planning thread, plus the kernels' atomics
