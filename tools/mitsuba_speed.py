@@ -27,6 +27,15 @@ robust Embree scene).
 Writes results/<machine>/mitsuba-vs-pathbench.json and .md, <machine> being the slug
 pb::machine_slug gives (tools/machine.py), with the CPU's vector flags (which ISAs this
 host has) and the ISA each pathbench run used.
+
+`--emulate-isa avx2` stands in for an AVX2-only host on an AVX-512 one (tools/isa_emulation.py):
+every pathbench run gets `--isa avx2`, Embree (pathbench's, pathbench-bench's and the one
+Mitsuba bundles) is capped by the LD_PRELOAD shim tools/isa_cap/embree_isa_cap.c, Dr.Jit's
+LLVM backend is set to haswell with 8 lanes, and glibc's dispatch is capped by its tunables.
+The tool builds the shim (build/isa_cap/, or --embree-shim) and re-executes itself with it
+preloaded. Each cap is read back and recorded (the results' `emulation`); a cap that did not
+take stops the run. Results go to mitsuba-vs-pathbench-avx2cap.json and .md, never over the
+native ones. It is an emulation: the caches, clocks and cores are the AVX-512 host's.
 """
 from __future__ import annotations
 
@@ -44,6 +53,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mitsuba_scene as ms  # noqa: E402
+import isa_emulation  # noqa: E402
 import raw_embree_mix  # noqa: E402
 from machine import cpu_model, cpu_vector_flags, host_fingerprint, machine_slug  # noqa: E402
 
@@ -61,12 +71,29 @@ class MitsubaRunner:
     """Mitsuba 3 on paper-cornell; the constructor loads the scene and does the
     warm-up render (JIT compilation), excluded from the timings."""
 
-    def __init__(self, spp, variant, size):
+    def __init__(self, spp, variant, size, emulate_isa=None):
         self.mi = ms.import_mitsuba(variant)
         import drjit as dr  # noqa: PLC0415
 
         self.dr, self.spp, self.variant = dr, spp, variant
+        self.emulation = None  # Dr.Jit's capped target, read back, and Mitsuba's Embree device
+        if emulate_isa:  # after set_variant (LLVM initialised), before any kernel of the scene
+            native_probe = isa_emulation.drjit_codegen_probe(dr)
+            self.emulation = {"drjit": isa_emulation.drjit_set_target(dr, emulate_isa)}
+            self.emulation["drjit"]["native_probe"] = native_probe
+            self.emulation["drjit"]["probe"] = isa_emulation.drjit_codegen_probe(dr)
+            isa_emulation.check_drjit(self.emulation["drjit"], emulate_isa)
+            print(f"Dr.Jit LLVM target: {self.emulation['drjit']['read_back']}, probe "
+                  f"{self.emulation['drjit']['probe']}", flush=True)
+        try:
+            self.llvm_target = isa_emulation.drjit_target(dr) if variant.startswith("llvm") else None
+        except (OSError, AttributeError):  # another Dr.Jit: jit.h's functions not found
+            self.llvm_target = None
         self.scene = ms.load_scene(self.mi, width=size, height=size, spp=spp)
+        if emulate_isa:  # Mitsuba made its Embree device while loading the scene
+            self.emulation["embree"] = isa_emulation.shim_report()
+            isa_emulation.check_embree(self.emulation["embree"], "Mitsuba", emulate_isa)
+            print(f"Mitsuba's Embree through the shim: {self.emulation['embree']}", flush=True)
         t0 = time.perf_counter()
         self.img = ms.render(self.mi, self.scene, spp, seed=0)
         self.warmup = time.perf_counter() - t0
@@ -88,6 +115,7 @@ class MitsubaRunner:
             "variant": self.variant,
             "integrator": f"path, max_depth {ms.MAX_DEPTH}, rr_depth beyond max_depth (no Russian roulette)",
             "threads": "all (Dr.Jit's thread pool)",
+            "llvm_target": self.llvm_target,  # Dr.Jit's cpu, features and vector width, read back
             "warmup_seconds": round(self.warmup, 3),
             "seconds": [round(t, 3) for t in self.times],
             "median_seconds": round(statistics.median(self.times), 3),
@@ -108,12 +136,13 @@ class PathbenchRunner:
     `spec` is a strategy, optionally with flags after '/': "wavefront/no-watertight",
     "pixel/isa=avx2" (an option with its value)."""
 
-    def __init__(self, binary, spec, spp, size, tmp, label=None):
+    def __init__(self, binary, spec, spp, size, tmp, label=None, emulate_isa=None):
         self.strategy, *flags = spec.split("/")
         self.flags = [x for f in flags for x in (f"--{f}".split("=", 1))]
         self.watertight = "no-watertight" not in flags
         self.label = label or spec
         self.binary, self.spp, self.size, self.tmp = binary, spp, size, Path(tmp)
+        self.emulate_isa = emulate_isa
         self.runs = []
 
     def run(self):
@@ -127,6 +156,8 @@ class PathbenchRunner:
         subprocess.run(cmd, check=True)
         r = json.loads(report.read_text())
         r["image_mean_rgb"] = [round(float(x), 5) for x in ms.read_pfm(image).reshape(-1, 3).mean(axis=0)]
+        if self.emulate_isa:
+            isa_emulation.check_pathbench_report(r, f"pathbench {self.label}", self.emulate_isa)
         self.runs.append(r)
         print(f"pathbench {self.label}: render {k + 1}: {r['seconds']:.2f} s, "
               f"{r['rays_per_second'] / 1e6:.2f} M rays/s", flush=True)
@@ -151,6 +182,7 @@ class PathbenchRunner:
             "embree_layout": med.get("embree_layout"),  # the report's: asked, used, why, probe times
             "isa": med.get("isa"),  # the path step's instruction set, as the report names it
             "isa_asked": med.get("isa_asked"),
+            "embree": (med.get("fingerprint") or {}).get("embree"),  # its Embree device: version, native widths
         }
 
 
@@ -175,14 +207,18 @@ def layout_lines(pb):
 def markdown(res):
     m, pb = res["mitsuba"], res["pathbench"]
     spp, px = res["settings"]["spp"], res["settings"]["width"] * res["settings"]["height"]
+    em = res.get("emulation")
     lines = [
-        f"# Mitsuba 3 vs pathbench on {res['machine']['cpu']}",
+        f"# Mitsuba 3 vs pathbench on {res['machine']['cpu']}"
+        + (f", emulating an {em['isa'].upper()}-only host" if em else ""),
         "",
         f"paper-cornell, {res['settings']['width']}x{res['settings']['height']}, {spp} spp, two bounces "
         "(Mitsuba `path` max_depth 3; pathbench `--bounces 2 --sampling nee`), box filter, "
         f"{res['machine']['hardware_threads']} hardware threads, measured {res['date']} "
         f"(load average before {res['load_average_before']}, after {res['load_average_after']}).",
     ]
+    if em:
+        lines += isa_emulation.markdown_lines(em)
     flags = res["machine"].get("cpu_flags")
     if flags is not None:
         lines += ["", "CPU vector flags: " + (" ".join(flags) or "none beyond SSE2") + "; pathbench's path step ran "
@@ -234,10 +270,27 @@ def markdown(res):
         *layout_lines(pb),
         f"pathbench revision {next(iter(pb.values()))['git_revision']}, {next(iter(pb.values()))['compiler']}.",
         "",
-        "Re-run: `.venv/bin/python tools/mitsuba_speed.py` (after `scripts/build.sh`).",
+        "Re-run: `.venv/bin/python tools/mitsuba_speed.py"
+        + (f" --emulate-isa {em['isa']}" if em else "") + "` (after `scripts/build.sh`).",
         "",
     ]
     return "\n".join(lines)
+
+
+def results_stem(emulate_isa=None):
+    """The results' file name without suffix: an emulated host's never overwrite the native ones."""
+    return "mitsuba-vs-pathbench" + (f"-{emulate_isa}cap" if emulate_isa else "")
+
+
+def emulated_specs(specs, isa):
+    """Every pathbench spec with `isa=<isa>` (the emulated host has no other), refusing another ISA."""
+    out = []
+    for s in specs:
+        asked = [f.split("=", 1)[1] for f in s.split("/")[1:] if f.startswith("isa=")]
+        if any(x != isa for x in asked):
+            sys.exit(f"--emulate-isa {isa}: spec {s!r} asks for another ISA")
+        out.append(s if asked else f"{s}/isa={isa}")
+    return list(dict.fromkeys(out))
 
 
 def main(argv=None):
@@ -257,12 +310,26 @@ def main(argv=None):
     ap.add_argument("--baseline", help="another pathbench binary (e.g. a build of an older commit): its pixel and "
                                        "wavefront strategies run in the same interleaved rounds, labelled "
                                        "'STRATEGY@baseline', so a before/after ratio comes from one run")
+    ap.add_argument("--emulate-isa", choices=sorted(isa_emulation.TARGETS),
+                    help="on an AVX-512 host, cap every component of both renderers at this ISA (pathbench --isa, "
+                         "Embree through the LD_PRELOAD shim, Dr.Jit's LLVM target, glibc's dispatch) to stand in "
+                         "for a host that has only it; results go to mitsuba-vs-pathbench-<isa>cap.*")
+    ap.add_argument("--embree-shim", default=str(isa_emulation.SHIM_DEFAULT),
+                    help="the shim for --emulate-isa (built there from tools/isa_cap/ when missing or older)")
     a = ap.parse_args(argv)
     specs = [s for s in a.strategies.split(",")]
     if a.isa:
         specs = [f"{s}/isa={i}" for s in specs for i in a.isa.split(",")]
     if not Path(a.pathbench).is_file():
         sys.exit(f"{a.pathbench}: not built (run scripts/build.sh, or pass --pathbench)")
+    emulate = a.emulate_isa
+    if emulate:
+        specs = emulated_specs(specs, emulate)
+        if not isa_emulation.host_has_avx512(cpu_vector_flags()):
+            sys.exit(f"--emulate-isa {emulate}: this host has no AVX-512, so it is a real host of its own ISA: "
+                     "run without --emulate-isa")
+        shim = isa_emulation.build_shim(Path(a.embree_shim))
+        isa_emulation.ensure_preloaded(emulate, shim, argv)  # re-executes the tool with the shim preloaded
 
     res = {
         "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
@@ -278,17 +345,22 @@ def main(argv=None):
     bench = Path(a.pathbench).parent / "pathbench-bench"
     raw_rounds = []
     with tempfile.TemporaryDirectory() as tmp:
-        mitsuba = MitsubaRunner(a.spp, a.variant, a.size)
-        ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp) for s in specs}
+        mitsuba = MitsubaRunner(a.spp, a.variant, a.size, emulate_isa=emulate)
+        ours = {s: PathbenchRunner(a.pathbench, s, a.spp, a.size, tmp, emulate_isa=emulate) for s in specs}
         if a.baseline:
-            for s in ("pixel", "wavefront"):
-                ours[f"{s}@baseline"] = PathbenchRunner(a.baseline, s, a.spp, a.size, tmp, label=f"{s}@baseline")
+            for s in emulated_specs(["pixel", "wavefront"], emulate) if emulate else ("pixel", "wavefront"):
+                label = f"{s.split('/')[0]}@baseline"
+                ours[label] = PathbenchRunner(a.baseline, s, a.spp, a.size, tmp, label=label, emulate_isa=emulate)
+        bench_context = {}
         for _ in range(a.repeats):
             mitsuba.run()
             for r in ours.values():
                 r.run()
             if bench.is_file() and not a.no_raw:
-                raw_rounds.append(raw_embree_mix.measure(bench))
+                raw_rounds.append(raw_embree_mix.measure(bench, context=bench_context))
+                if emulate:
+                    isa_emulation.check_embree((bench_context.get("fingerprint") or {}).get("embree"),
+                                               "pathbench-bench", emulate)
                 print("raw Embree: " + ", ".join(f"{n.split('/')[2]}/{n.split('/')[3]} {v / 1e6:.1f} M/s"
                                                  for n, v in sorted(raw_rounds[-1].items())), flush=True)
         res["mitsuba"] = mitsuba.result()
@@ -305,6 +377,13 @@ def main(argv=None):
                     "isa": r.get("isa"),
                     "raw_rays_per_second": round(raw), "share": round(r["median_rays_per_second"] / raw, 4)}
     res["load_average_after"] = loadavg()
+    if emulate:
+        pb = res["pathbench"]
+        first = next(iter(ours.values())).runs[0]
+        res["emulation"] = isa_emulation.record(
+            emulate, shim, mitsuba.emulation["drjit"], mitsuba.emulation["embree"],
+            {s: r["embree"] for s, r in pb.items()}, (bench_context.get("fingerprint") or {}).get("embree"),
+            {s: r["isa"] for s, r in pb.items()}, (first.get("fingerprint") or {}).get("build"))
 
     samples = a.size * a.size * a.spp
     rps = FULL_TRACE_RAYS_PER_SAMPLE
@@ -319,9 +398,10 @@ def main(argv=None):
 
     out = Path(a.out_dir) if a.out_dir else ROOT / "results" / res["machine"]["slug"]
     out.mkdir(parents=True, exist_ok=True)
-    (out / "mitsuba-vs-pathbench.json").write_text(json.dumps(res, indent=2) + "\n")
+    stem = results_stem(emulate)
+    (out / f"{stem}.json").write_text(json.dumps(res, indent=2) + "\n")
     md = markdown(res)
-    (out / "mitsuba-vs-pathbench.md").write_text(md)
+    (out / f"{stem}.md").write_text(md)
     print(md)
     return 0
 

@@ -44,8 +44,10 @@ def bench_name(kind: str, width: str) -> str:
     return f"raycast/cpu/{api}{width}/{coherence}/{SCENE}/real_time"
 
 
-def measure(bench_binary: str | Path, preset: str = "paper") -> dict[str, float]:
-    """Runs the raycast benchmarks once; returns rays/s by benchmark name."""
+def measure(bench_binary: str | Path, preset: str = "paper", context: dict | None = None) -> dict[str, float]:
+    """Runs the raycast benchmarks once; returns rays/s by benchmark name. `context`, when
+    given, is updated with the run's Google Benchmark context (its fingerprint names the
+    Embree device: version, native packet widths)."""
     names = sorted({bench_name(k, w) for k in KINDS for w in WIDTH.values()})
     pattern = "^(" + "|".join(n.replace("/real_time", "") for n in names) + ")"
     with tempfile.TemporaryDirectory() as tmp:
@@ -53,7 +55,10 @@ def measure(bench_binary: str | Path, preset: str = "paper") -> dict[str, float]
         subprocess.run([str(bench_binary), "--preset", preset, f"--benchmark_filter={pattern}",
                         f"--benchmark_out={out}", "--benchmark_out_format=json"],
                        check=True, stdout=subprocess.DEVNULL)
-        runs = json.loads(out.read_text())["benchmarks"]
+        data = json.loads(out.read_text())
+        runs = data["benchmarks"]
+        if context is not None:
+            context.update(data.get("context", {}))
     rates = {b["name"]: float(b["rays_per_second"]) for b in runs if b["name"] in names}
     missing = set(names) - set(rates)
     if missing:

@@ -154,3 +154,87 @@ def test_slugify_is_the_cpp_rule():
     assert machine.slugify("cornell-box:mirror", "x") == "cornell-box-mirror"
     assert machine.slugify("caf\u00e9 GPU", "x") == "caf-gpu"
     assert machine.slugify(" -- ", "scene") == "scene"
+
+
+def _emulated_result():
+    import isa_emulation
+    from pathlib import Path
+    res = _speed_result()
+    res["machine"]["cpu_flags"] = ["avx2", "avx512f"]
+    res["pathbench"] = {"pixel/isa=avx2": res["pathbench"]["pixel"] | {"isa": "avx2"}}
+    widths = {"native_packet_widths": [4, 8]}
+    drjit = {"native": {"cpu": "znver4", "features": "+avx512f", "vector_width": 16},
+             "asked": {"cpu": "haswell", "features": "+avx2,-avx512f", "vector_width": 8},
+             "read_back": {"cpu": "haswell", "features": "+avx2,-avx512f", "vector_width": 8},
+             "probe": {"disassembly_lines": 50, "zmm_instructions": 0, "ymm_instructions": 40},
+             "native_probe": {"disassembly_lines": 40, "zmm_instructions": 36, "ymm_instructions": 0}}
+    mitsuba_embree = {"devices": 1, "library": "mitsuba-embree", "max_isa": "avx2",
+                      "config": "threads=2,max_isa=avx2", "created": True, "native_packet_widths": [4, 8]}
+    res["emulation"] = isa_emulation.record("avx2", Path("/x/libembree_isa_cap.so"), drjit, mitsuba_embree,
+                                            {"pixel/isa=avx2": widths}, widths, {"pixel/isa=avx2": "avx2"},
+                                            {"isa_compiled": ["sse2"], "cxx_flags": "-O3"})
+    return res
+
+
+def test_speed_markdown_states_the_emulation():
+    res = _emulated_result()
+    md = mitsuba_speed.markdown(res)
+    assert md.startswith("# Mitsuba 3 vs pathbench on Test CPU, emulating an AVX2-only host\n")
+    assert ("**Emulated AVX2-only host.** This is an AVX-512 host with every component capped at AVX2, NOT a real "
+            "AVX2-only host") in md
+    assert "pathbench's path step `--isa avx2` (ran: pixel/isa=avx2: avx2)" in md
+    assert ("pathbench pixel/isa=avx2 widths 4/8; pathbench-bench (raw rates) widths 4/8; Mitsuba's bundled Embree "
+            "widths 4/8 (config `threads=2,max_isa=avx2`)") in md
+    assert ("Dr.Jit's LLVM backend set to cpu `haswell`, vector width 8, features `+avx2,-avx512f` (native: `znver4`, "
+            "width 16); a probe kernel's disassembly has 0 zmm and 40 ymm instructions (the same kernel for the "
+            "native target: 36 zmm, 0 ymm)") in md
+    assert "Re-run: `.venv/bin/python tools/mitsuba_speed.py --emulate-isa avx2`" in md
+    assert "emulat" not in mitsuba_speed.markdown(_speed_result()).lower()  # native results say nothing of it
+
+
+def test_speed_emulation_json_record():
+    import json
+    em = json.loads(json.dumps(_emulated_result()["emulation"]))  # all of it goes into the JSON
+    assert em["isa"] == "avx2" and "NOT a real AVX2-only host" in em["statement"]
+    assert set(em["covered"]) == {"pathbench_path_step", "embree", "drjit_llvm", "glibc"}
+    assert em["covered"]["embree"]["mitsuba"]["native_packet_widths"] == [4, 8]
+    assert em["covered"]["drjit_llvm"]["read_back"]["vector_width"] == 8
+    assert mitsuba_speed.results_stem("avx2") == "mitsuba-vs-pathbench-avx2cap"
+    assert mitsuba_speed.results_stem() == "mitsuba-vs-pathbench"  # the native results' names are kept
+
+
+def test_speed_emulation_forces_the_isa_of_every_spec():
+    assert mitsuba_speed.emulated_specs(["pixel", "wavefront/no-watertight", "pixel/isa=avx2"], "avx2") == [
+        "pixel/isa=avx2", "wavefront/no-watertight/isa=avx2"]
+    with pytest.raises(SystemExit):
+        mitsuba_speed.emulated_specs(["pixel/isa=avx512"], "avx2")
+
+
+def test_speed_emulation_checks_refuse_an_uncapped_run():
+    import isa_emulation
+    ok = {"isa": "avx2", "fingerprint": {"build": {"isa_compiled": ["sse2"], "cxx_flags": "-O3"},
+                                         "embree": {"isa_derived": "avx2", "native_packet_widths": [4, 8]}}}
+    isa_emulation.check_pathbench_report(ok, "run", "avx2")
+    bad = [ok | {"isa": "avx512"},
+           ok | {"fingerprint": ok["fingerprint"] | {"embree": {"isa_derived": "avx512",
+                                                                "native_packet_widths": [4, 8, 16]}}},
+           ok | {"fingerprint": ok["fingerprint"] | {"embree": None}},
+           ok | {"fingerprint": ok["fingerprint"] | {"build": {"isa_compiled": ["sse2"],
+                                                               "cxx_flags": "-O3 -march=native"}}}]
+    for r in bad:
+        with pytest.raises(RuntimeError):
+            isa_emulation.check_pathbench_report(r, "run", "avx2")
+    with pytest.raises(RuntimeError):
+        isa_emulation.check_drjit({"read_back": {"features": "+avx512f"}}, "avx2")
+    with pytest.raises(RuntimeError):
+        isa_emulation.check_drjit({"read_back": {"features": "+avx2"}, "probe": {"zmm_instructions": 3}}, "avx2")
+
+
+def test_speed_emulation_needs_the_shim_preloaded():
+    import isa_emulation
+    from pathlib import Path
+    if isa_emulation.shim_report() is None:  # pytest itself runs without the shim
+        with pytest.raises(SystemExit, match="not preloaded"):
+            isa_emulation.ensure_preloaded("avx2", Path("/x/shim.so"), argv=["--emulate-isa", "avx2"])
+    assert isa_emulation.glibc_tunables("avx2", None).startswith("glibc.cpu.hwcaps=-AVX512F,")
+    assert isa_emulation.glibc_tunables("avx2", "a=1").startswith("a=1:glibc.cpu.hwcaps=")
