@@ -43,7 +43,7 @@ void merge_ranks(RunReport& report, const std::vector<std::string>& ranks, doubl
   nlohmann::json per_rank = nlohmann::json::array();
   RayCounts rays;
   uint64_t paths = 0, discarded = 0, peak_device = 0, peak_host = 0;
-  double busy_sum = 0, busy_max = 0;
+  double busy_sum = 0, busy_max = 0, wall_max = 0;
   uint64_t spp_sum = 0;
   std::map<std::string, uint64_t> by_device;
   for (const std::string& text : ranks) {
@@ -56,6 +56,7 @@ void merge_ranks(RunReport& report, const std::vector<std::string>& ranks, doubl
     if (!e["peak_device_bytes"].is_null()) peak_device = std::max(peak_device, e["peak_device_bytes"].get<uint64_t>());
     peak_host = std::max(peak_host, e["peak_host_bytes"].get<uint64_t>());
     const double busy = e["tracer_seconds"].get<double>();
+    wall_max = std::max(wall_max, e["wall_seconds"].get<double>());
     busy_sum += busy;
     busy_max = std::max(busy_max, busy);
     const uint64_t traced = e["samples"].get<uint64_t>();
@@ -74,19 +75,24 @@ void merge_ranks(RunReport& report, const std::vector<std::string>& ranks, doubl
   nlohmann::json share = nlohmann::json::object();
   for (const auto& [device, spp] : by_device) share[device] = spp_sum ? double(spp) / double(spp_sum) : 0.0;
   const double mean = busy_sum / n;
+  // Each rank times its part from its own exit of the common barrier; one that left the
+  // barrier before rank 0 (a loaded host: milliseconds) traced longer than rank 0's frame.
+  // The frame the efficiency is measured against lasts at least every rank's part.
+  const double span = std::max(frame_seconds, wall_max);
   report.extra["ranks"] = {
       {"count", ranks.size()},
       {"balance", balance},
       {"frame_seconds", frame_seconds},
       {"reduce_seconds", reduce_seconds},
       {"load_balance", mean > 0 ? busy_max / mean : 1.0},
-      {"parallel_efficiency", frame_seconds > 0 ? busy_sum / (n * frame_seconds) : 0.0},
+      {"parallel_efficiency", span > 0 ? busy_sum / (n * span) : 0.0},
       {"device_share", share},
       {"peak_host_bytes_max", peak_host},
       {"per_rank", per_rank},
       {"note",
        "load_balance: max/mean of the ranks' tracer seconds; parallel_efficiency: sum of tracer seconds / (ranks x "
-       "frame seconds); frame seconds: common start to the film reduced on rank 0"}};
+       "frame seconds, or the longest rank's own wall seconds where longer); frame seconds: common start to the film "
+       "reduced on rank 0"}};
 }
 
 std::string first_difference(const std::string& rank0, const std::string& mine) {

@@ -5,7 +5,9 @@
 //   per_rank             device, host, GPU index or threads, samples per pixel, chunks,
 //                        tracer seconds, rays, memory, of each rank;
 //   load_balance         max / mean of the ranks' tracer seconds (1 = even);
-//   parallel_efficiency  sum of the ranks' tracer seconds / (ranks x frame seconds): the
+//   parallel_efficiency  sum of the ranks' tracer seconds / (ranks x frame seconds; the
+//                        longest rank's own wall seconds where a rank left the common
+//                        barrier early and traced longer than rank 0's frame): the
 //                        share of the ranks' time spent tracing rather than waiting, in
 //                        chunk overhead or in the reduction (1 = none lost). Strong-scaling
 //                        efficiency against one rank (T1 / (N x TN)) needs a one-rank run:
