@@ -49,7 +49,7 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     const uint32_t parity = uint32_t(it & 1);
     const WaveStep step{parity, static_cast<unsigned long long>(total), cap, &planned_[it % kPlanSlots]};
-    with_traversal_kind(g.bvh.kind, [&](auto kind) {  // intersect compiled for the BVH layout
+    with_traversal_kind(g.bvh, [&](auto kind) {  // intersect compiled for the BVH layout
       launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, step, spp);
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
@@ -58,7 +58,7 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
       else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
     });
     if (shadows_.records) {
-      with_traversal_kind(g.bvh.kind, [&](auto kind) {
+      with_traversal_kind(g.bvh, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
         if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, parity, film);
         else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, parity, film);

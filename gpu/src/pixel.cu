@@ -98,7 +98,7 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
     if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny, 1>) : go(k_pixel<false, K, double, true, kAny, 1>);
     else if (!watertight) variance ? go(k_pixel<true, K, float, false, kAny, 1>) : go(k_pixel<false, K, float, false, kAny, 1>);
     else
-      with_traversal_kind(g.bvh.kind, [&](auto kind) {
+      with_traversal_kind(g.bvh, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
         if (min_blocks == 5) variance ? go(k_pixel<true, K, float, true, B, 5>) : go(k_pixel<false, K, float, true, B, 5>);
         else variance ? go(k_pixel<true, K, float, true, B, 3>) : go(k_pixel<false, K, float, true, B, 3>);

@@ -45,7 +45,7 @@ std::vector<TraceResult> trace_on_device(const Scene& scene, const std::vector<T
   std::vector<TraceResult> out(rays.size());
   if (rays.empty()) return out;
   Launcher launch(nullptr, false);
-  with_traversal_kind(gs.impl().bvh.kind, [&](auto kind) {
+  with_traversal_kind(gs.impl().bvh, [&](auto kind) {
     launch.launch("trace", k_trace<decltype(kind)::value>, rays.size(), gs.impl().bvh, d_rays.get(), d_out.get(),
                   uint32_t(rays.size()), any_hit);
   });
@@ -68,7 +68,7 @@ std::vector<double> time_trace_on_device(const GpuScene& gs, const std::vector<T
   for (int r = -1; r < repeats; ++r) {  // r = -1: warm-up, not timed
     PB_CUDA_CHECK(cudaMemset(d_out.get(), 0xAB, sizeof(TraceResult) * n));  // poison
     PB_CUDA_CHECK(cudaEventRecord(start.e, nullptr));
-    with_traversal_kind(gs.impl().bvh.kind, [&](auto kind) {
+    with_traversal_kind(gs.impl().bvh, [&](auto kind) {
       launch.launch("trace", k_trace<decltype(kind)::value>, n, gs.impl().bvh, d_rays.get(), d_out.get(), n, any_hit);
     });
     PB_CUDA_CHECK(cudaEventRecord(stop.e, nullptr));

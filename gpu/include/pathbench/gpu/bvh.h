@@ -237,9 +237,14 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
 // own direction (need not be unit length). Returns the scene triangle id, or kNoHit;
 // t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
 // Moeller-Trumbore (the paper's; the accuracy study's comparison).
-template <bool kAnyHit, bool kWatertight = true>
+// kExact: the view's exact_ties read at run time (-1), or known at compile time (0, 1):
+// the hot kernels are compiled for one or the other, since a run-time flag keeps the tie
+// compare's registers live in every kernel (ptxas, sm_90, k_pixel: 48 -> 60 bytes of
+// spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (gpu/NOTES.md).
+template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
 PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
+  const bool exact = kExact < 0 ? bvh.exact_ties != 0 : kExact == 1;
   const WatertightRay wr = make_watertight_ray(o, d);
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
@@ -247,8 +252,7 @@ PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d
       bvh.nodes, o, d, t,
       [&](uint32_t first, uint32_t count) {
         for (uint32_t i = first; i < first + count; ++i)
-          if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, bvh.exact_ties != 0, t, hit, hit_slot, stats) &&
-              kAnyHit)
+          if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, exact, t, hit, hit_slot, stats) && kAnyHit)
             return true;
         return false;
       },

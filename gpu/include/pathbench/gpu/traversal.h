@@ -35,8 +35,11 @@ struct BvhView {
 };
 
 // kKind: a TraversalKind the caller was compiled for (bvh.kind must be it), or
-// kAnyKind to switch on bvh.kind.
+// kAnyKind to switch on bvh.kind. kBinaryExactTies: the binary BVH of a scene with
+// instances traced flat (exact_ties set), compiled apart from Binary (exact_ties unset)
+// so that flat scenes' kernels carry no tie compare (bvh.h's traverse, kExact).
 constexpr int kAnyKind = -1;
+constexpr int kBinaryExactTies = 4;
 
 template <bool kAnyHit, bool kWatertight = true, int kKind = kAnyKind>
 PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
@@ -46,7 +49,9 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
   } else if constexpr (kKind == int(TraversalKind::AllTriangles)) {
     return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
   } else if constexpr (kKind == int(TraversalKind::Binary)) {
-    return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
+    return traverse<kAnyHit, kWatertight, 0>(bvh.binary, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == kBinaryExactTies) {
+    return traverse<kAnyHit, kWatertight, 1>(bvh.binary, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::TwoLevel)) {
     return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
   } else {
@@ -71,11 +76,13 @@ PB_HD bool occluded(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_
   return traverse<true, kWatertight, kKind>(bvh, o, d, t_max, t) != kNoHit;
 }
 
-// Calls fn(std::integral_constant<int, kind>{}) for the view's kind: picks the kernel
-// compiled for it (host code).
+// Calls fn(std::integral_constant<int, kind>{}) for the view's kind (kBinaryExactTies for
+// a binary BVH with exact_ties): picks the kernel compiled for it (host code).
 template <class Fn>
-decltype(auto) with_traversal_kind(TraversalKind kind, Fn&& fn) {
-  switch (kind) {
+decltype(auto) with_traversal_kind(const BvhView& bvh, Fn&& fn) {
+  if (bvh.kind == TraversalKind::Binary && bvh.binary.exact_ties)
+    return fn(std::integral_constant<int, kBinaryExactTies>{});
+  switch (bvh.kind) {
     case TraversalKind::Wide: return fn(std::integral_constant<int, int(TraversalKind::Wide)>{});
     case TraversalKind::AllTriangles: return fn(std::integral_constant<int, int(TraversalKind::AllTriangles)>{});
     case TraversalKind::TwoLevel: return fn(std::integral_constant<int, int(TraversalKind::TwoLevel)>{});
