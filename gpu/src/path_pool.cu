@@ -1,6 +1,7 @@
-// The wavefront and paper-queue strategies' frame loop: intersect (which plans the
-// iteration), shade and shadow launched in turn on one stream (no host wait between
-// them); whether the frame is done is read from mapped host memory the kernels write.
+// The wavefront and paper-queue strategies' frame loop: trace (plans the iteration,
+// traces the last iteration's shadow rays and this one's closest hits) and shade launched
+// in turn on one stream (no host wait between them); whether the frame is done is read
+// from mapped host memory the trace kernels write.
 #include "path_pool.cuh"
 
 #include <stdexcept>
@@ -12,7 +13,7 @@ namespace pb::gpu {
 
 namespace {
 
-// What an intersect kernel wrote into `slot` (mapped host memory: 1 if its iteration has
+// What a trace kernel wrote into `slot` (mapped host memory: 1 if its iteration has
 // paths, 0 if not), waiting for the GPU to get there; a failure in the stream is reported instead of waiting forever.
 uint32_t wait_for_plan(cudaStream_t stream, const uint32_t& slot) {
   const volatile uint32_t& v = slot;
@@ -37,7 +38,7 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   WaveCounters* ctr = ctr_.get();
   const uint32_t cap = uint32_t(capacity_);
   FrameResult r;
-  // Whether the frame is done is read from the plans the intersect kernels write into
+  // Whether the frame is done is read from the plans the trace kernels write into
   // mapped host memory: no copy or synchronisation in the stream, so the GPU never
   // idles while the host looks (a synchronous look every 4 iterations drained the queue
   // 20 times a paper frame). The host stays kLag iterations ahead of what it reads, so
@@ -49,21 +50,21 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     const uint32_t parity = uint32_t(it & 1);
     const WaveStep step{parity, static_cast<unsigned long long>(total), cap, &planned_[it % kPlanSlots]};
-    with_traversal_kind(g.bvh, [&](auto kind) {  // intersect compiled for the BVH layout
-      launch.launch("intersect", k_wf_intersect<decltype(kind)::value>, 0, g.view, c, g.bvh, cur, prim_.get(), ctr, step, spp);
+    with_traversal_kind(g.bvh, [&](auto kind) {  // trace compiled for the BVH layout
+      constexpr int B = decltype(kind)::value;
+      const bool shadows = shadows_.records;
+      if (variance && shadows)
+        launch.launch("trace", k_wf_trace<true, true, B>, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
+      else if (shadows)
+        launch.launch("trace", k_wf_trace<false, true, B>, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
+      else
+        launch.launch("trace", k_wf_trace<false, false, B>, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;
       if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
       else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
     });
-    if (shadows_.records) {
-      with_traversal_kind(g.bvh, [&](auto kind) {
-        constexpr int B = decltype(kind)::value;
-        if (variance) launch.launch("shadow", k_wf_shadow<true, B>, 0, g.bvh, sh, next, ctr, parity, film);
-        else launch.launch("shadow", k_wf_shadow<false, B>, 0, g.bvh, sh, next, ctr, parity, film);
-      });
-    }
     if (it >= kLag) {
       const uint64_t seen = it - kLag;
       const uint32_t has_paths = wait_for_plan(stream, planned_[seen % kPlanSlots]);
@@ -74,7 +75,8 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
       }
     }
   }
-  // The empty iteration's intersect booked every one before it; every path has ended.
+  // The empty iteration's trace booked every one before it and traced their last shadow
+  // rays; every path has ended.
   PB_CUDA_CHECK(cudaMemcpyAsync(host_ctr_, ctr, sizeof(WaveCounters), cudaMemcpyDeviceToHost, stream));
   PB_CUDA_CHECK(cudaStreamSynchronize(stream));
   r.stats = host_ctr_->stats;

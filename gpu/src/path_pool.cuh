@@ -74,7 +74,7 @@ class PathPool {
   DeviceBuffer<float2> sh_ct_, sh_c2_;
   DeviceBuffer<WaveCounters> ctr_;
   WaveCounters* host_ctr_ = nullptr;  // the counters at the end of a frame
-  // Mapped host memory: iteration i's intersect writes into slot i % kPlanSlots whether it
+  // Mapped host memory: iteration i's trace kernel writes into slot i % kPlanSlots whether it
   // has paths to trace (run reads them while the GPU works, resets them to kNotPlanned).
   static constexpr int kPlanSlots = 8;
   uint32_t* planned_ = nullptr;

@@ -1,10 +1,10 @@
 #pragma once
-// The wavefront's stage kernels, one per stage: intersect (plans the iteration from the
-// one before: the refill with new samples; then the closest hits, new samples' camera
-// rays made there and again in shade, never stored), shade (the shared path
-// step; continuing paths compacted into the next buffer, shadow rays queued) and shadow
-// (occlusion, then radiance to the film or the continuing path). Launched by PathPool
-// (path_pool.cu, the only includer).
+// The wavefront's two stage kernels. trace: plans the iteration from the one before (the
+// refill with new samples), traces the shadow rays the iteration before queued
+// (occlusion, then radiance to the film or the continuing path), then this iteration's
+// closest hits (new samples' camera rays made there and again in shade, never stored).
+// shade: the shared path step; continuing paths compacted into the next buffer, shadow
+// rays queued. Launched by PathPool (path_pool.cu, the only includer).
 #include <cuda_runtime.h>
 
 #include "device_film.cuh"
@@ -17,7 +17,7 @@ namespace pb::gpu {
 namespace {
 
 // This iteration's plan, from the one before (`prev`, complete: its kernels are done):
-// the paths that continued, then as many new samples as fit. Every intersect thread
+// the paths that continued, then as many new samples as fit. Every trace thread
 // computes it (a few uniform loads), so no launch between iterations is needed.
 struct IterationPlan {
   uint32_t n_cur, gen_dst;
@@ -33,9 +33,10 @@ __device__ __forceinline__ IterationPlan plan_iteration(const IterationCounters&
   return {cont + n, cont, prev.next_after, prev.next_after + n};
 }
 
-// Thread 0 of the intersect kernel: records the plan for shade and shadow (and the host)
-// and books the iteration before into the stats. The record it overwrites was last used
-// two iterations ago; the stats are touched by no other kernel while intersect runs.
+// Thread 0 of the trace kernel: records the plan for shade and the next trace and books
+// the iteration before into the stats. The record it overwrites was last used two
+// iterations ago; no other thread touches these stats fields meanwhile (the shadow rays
+// of the same kernel add to stats.discarded only).
 __device__ __forceinline__ void record_plan(WaveCounters* ctr, uint32_t parity, const IterationPlan& plan) {
   const IterationCounters& prev = ctr->it[parity ^ 1u];
   ctr->stats.bounce += prev.n_next;
@@ -54,7 +55,7 @@ struct WaveStep {
 
 // This iteration's new samples: indices [gen_dst, n_cur) of the current buffer, after
 // the continuing paths; a warp takes consecutive samples of a pixel, as the pixel
-// strategy does (coherent camera rays). They are never stored: intersect and shade each
+// strategy does (coherent camera rays). They are never stored: trace and shade each
 // make the camera path from its sample index (path_begin: one random draw and a camera
 // ray), which costs less than writing 64 bytes a new path and reading them back twice.
 struct NewPaths {
@@ -75,16 +76,65 @@ __device__ __forceinline__ PathState<float> current_path(const SceneView& s, con
 template <int kKind>
 constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
 
-template <int kKind>  // the BVH layout (traversal.h)
-__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_intersect(SceneView s, PathConfig c, BvhView bvh, PathSoA cur, uint32_t* prim,
-                                                                                     WaveCounters* ctr, WaveStep step, uint32_t spp) {
+// The shadow rays the last shade queued (n of them): occlusion, then the radiance to the
+// film (a path that ended) or to the continuing path in `next` (which the next shade reads).
+template <bool kVariance, int kKind>
+__device__ __forceinline__ void trace_shadow_rays(const BvhView& bvh, const ShadowSoA& sh, const PathSoA& next, uint32_t n,
+                                                  const FilmDev& film, unsigned long long* discarded) {
+  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
+  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
+    const uint32_t i = base + lane;
+    bool add = false;
+    uint32_t pixel = 0;
+    Vec3f L{0.0f, 0.0f, 0.0f};
+    if (i < n) {
+      const float4 o = sh.o[i], d = sh.d[i];
+      const float2 ct = sh.ct[i];
+      const uint32_t target = __float_as_uint(ct.y);
+      const Vec3f origin{o.x, o.y, o.z};
+      const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
+      if (target & kShadowDone) {
+        const float4 l = sh.L[i];
+        L = {l.x, l.y, l.z};
+        if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
+        if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
+          const float4 d2 = sh.d2[i];
+          const float2 c2 = sh.c2[i];
+          if (!occluded<true, kKind>(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
+        }
+        add = true;
+        pixel = target & ~kShadowDone;
+      } else if (visible) {
+        float4 Lt = next.L[target];
+        Lt.x = Lt.x + o.w;
+        Lt.y = Lt.y + d.w;
+        Lt.z = Lt.z + ct.x;
+        next.L[target] = Lt;
+      }
+    }
+    film_add_warp<kVariance>(film, add, pixel, L, discarded);
+  }
+}
+
+// One launch for both traversal stages: the shadow rays the iteration before queued
+// (kShadows), then this iteration's closest hits. The shadows' radiance goes to paths in
+// `cur` (L), the closest hits read their rays (o, d): different fields, and shade, which
+// reads both, comes after. Planned here too (plan_iteration). One launch fewer an
+// iteration, and a block that runs out of shadow rays goes on to closest hits.
+template <bool kVariance, bool kShadows, int kKind>  // kKind: the BVH layout (traversal.h)
+__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>)
+    k_wf_trace(SceneView s, PathConfig c, BvhView bvh, PathSoA cur, uint32_t* prim, ShadowSoA sh, WaveCounters* ctr,
+               WaveStep step, FilmDev film, uint32_t spp) {
   kernel_prologue();
-  const IterationPlan plan = plan_iteration(ctr->it[step.parity ^ 1u], step.total, step.capacity);
+  const IterationCounters& prev = ctr->it[step.parity ^ 1u];
+  const IterationPlan plan = plan_iteration(prev, step.total, step.capacity);
+  const uint32_t n_shadow = prev.n_shadow;  // thread 0 below writes it[parity], not prev
   if (grid_thread() == 0) {
     record_plan(ctr, step.parity, plan);
     *reinterpret_cast<volatile uint32_t*>(step.planned) = plan.n_cur != 0;  // for the host's loop
     __threadfence_system();
   }
+  if constexpr (kShadows) trace_shadow_rays<kVariance, kKind>(bvh, sh, cur, n_shadow, film, &ctr->stats.discarded);
   const uint32_t n = plan.n_cur;
   const NewPaths fresh{plan.gen_dst, plan.gen_base, spp};
   for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
@@ -135,7 +185,7 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
         bool wants_shadow;
         PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
         // The next vertex would be the last: answer it here (trace_path does the same
-        // at the top of its loop), so the path never goes through intersect + shade again.
+        // at the top of its loop), so the path never goes through trace + shade again.
         bool final_ray = false;
         if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
           final_ray = path_final_query<Kinds>(s, c, st, fq);
@@ -167,46 +217,6 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
     film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
     const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
     if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
-  }
-}
-
-template <bool kVariance, int kKind>
-__global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>) k_wf_shadow(BvhView bvh, ShadowSoA sh, PathSoA next, WaveCounters* ctr,
-                                                      uint32_t parity, FilmDev film) {
-  kernel_prologue();
-  const uint32_t n = ctr->it[parity].n_shadow;
-  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
-  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
-    const uint32_t i = base + lane;
-    bool add = false;
-    uint32_t pixel = 0;
-    Vec3f L{0.0f, 0.0f, 0.0f};
-    if (i < n) {
-      const float4 o = sh.o[i], d = sh.d[i];
-      const float2 ct = sh.ct[i];
-      const uint32_t target = __float_as_uint(ct.y);
-      const Vec3f origin{o.x, o.y, o.z};
-      const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
-      if (target & kShadowDone) {
-        const float4 l = sh.L[i];
-        L = {l.x, l.y, l.z};
-        if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
-        if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
-          const float4 d2 = sh.d2[i];
-          const float2 c2 = sh.c2[i];
-          if (!occluded<true, kKind>(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
-        }
-        add = true;
-        pixel = target & ~kShadowDone;
-      } else if (visible) {
-        float4 Lt = next.L[target];
-        Lt.x = Lt.x + o.w;
-        Lt.y = Lt.y + d.w;
-        Lt.z = Lt.z + ct.x;
-        next.L[target] = Lt;
-      }
-    }
-    film_add_warp<kVariance>(film, add, pixel, L, &ctr->stats.discarded);
   }
 }
 

@@ -40,7 +40,7 @@ struct ShadowSoA {
 constexpr uint32_t kShadowDone = 0x80000000u;  // pixels < 2^31 (RenderSettings::validate)
 
 // One iteration's plan and appends. Two alternate (iteration i uses it[i & 1]): the
-// intersect kernel of iteration i plans it from it[(i + 1) & 1], the iteration before,
+// trace kernel of iteration i plans it from it[(i + 1) & 1], the iteration before,
 // which nobody writes any more, while it[i & 1], last used two iterations ago, is free
 // to be reset. So no kernel of its own and no grid-wide barrier is needed to plan.
 struct IterationCounters {
