@@ -55,18 +55,25 @@ template <class T> inline bool occluded(const EmbreeScene& e, RTCIntersectContex
   return sr.tfar < 0.0f;  // Embree marks an occluded ray with tfar = -inf
 }
 
-// Packets of 8 or 16 rays (the batched path step's widths: AVX2, AVX-512).
-inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<8>& p) {
-  rtcIntersect8(valid, s, c, reinterpret_cast<RTCRayHit8*>(&p));
+// Packets of 8 or 16 rays (the batched path step's widths: AVX2, AVX-512), lanes [0, n)
+// active: every caller fills its packet from lane 0.
+template <int W> struct LaneMask {
+  alignas(64) int valid[W];
+  explicit LaneMask(int n) {
+    for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+  }
+};
+inline void intersect_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<8>& p) {
+  rtcIntersect8(LaneMask<8>(n).valid, s, c, reinterpret_cast<RTCRayHit8*>(&p));
 }
-inline void intersect_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<16>& p) {
-  rtcIntersect16(valid, s, c, reinterpret_cast<RTCRayHit16*>(&p));
+inline void intersect_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<16>& p) {
+  rtcIntersect16(LaneMask<16>(n).valid, s, c, reinterpret_cast<RTCRayHit16*>(&p));
 }
-inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<8>& p) {
-  rtcOccluded8(valid, s, c, reinterpret_cast<RTCRay8*>(&p));
+inline void occluded_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayNt<8>& p) {
+  rtcOccluded8(LaneMask<8>(n).valid, s, c, reinterpret_cast<RTCRay8*>(&p));
 }
-inline void occluded_packet(const int* valid, RTCScene s, RTCIntersectContext* c, RTCRayNt<16>& p) {
-  rtcOccluded16(valid, s, c, reinterpret_cast<RTCRay16*>(&p));
+inline void occluded_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayNt<16>& p) {
+  rtcOccluded16(LaneMask<16>(n).valid, s, c, reinterpret_cast<RTCRay16*>(&p));
 }
 
 // Packet fields that stay as set: everything but the ray, tfar and the hit.

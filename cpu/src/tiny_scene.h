@@ -133,9 +133,7 @@ int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e
   uint32_t unsure = k.tiny_closest(t, rays, p.ray.tfar, prim) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
   copy_rays<W>(rays, p.ray);
-  alignas(64) int valid[W];
-  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-  intersect_packet(valid, e.handle(), &ctx, p);
+  intersect_packet(n, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i)
     if ((unsure >> i) & 1) prim[i] = packet_triangle(e, p, i);
   return __builtin_popcount(unsure);
@@ -150,9 +148,7 @@ int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& 
   uint32_t unsure = k.tiny_occluded(t, rays, p.tfar, blocked) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
   copy_rays<W>(rays, p);
-  alignas(64) int valid[W];
-  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-  occluded_packet(valid, e.handle(), &ctx, p);
+  occluded_packet(n, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i)
     if ((unsure >> i) & 1) blocked[i] = p.tfar[i] < 0.0f;
   return __builtin_popcount(unsure);
@@ -161,17 +157,13 @@ int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& 
 // Embree's closest hits for packet p's lanes [0, n) (rays and tfar set), as scene
 // triangles (or RTC_INVALID_GEOMETRY_ID) in prim; p's tfar and geomID reset after.
 template <int W> void embree_closest(const EmbreeScene& e, RTCIntersectContext& ctx, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
-  alignas(64) int valid[W];
-  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-  intersect_packet(valid, e.handle(), &ctx, p);
+  intersect_packet(n, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i) prim[i] = packet_triangle(e, p, i);
   reset_packet(p);
 }
 // Embree's answer whether each of packet p's shadow rays [0, n) is blocked; tfar reset after.
 template <int W> void embree_occluded(const EmbreeScene& e, RTCIntersectContext& ctx, RTCRayNt<W>& p, int n, bool* blocked) {
-  alignas(64) int valid[W];
-  for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
-  occluded_packet(valid, e.handle(), &ctx, p);
+  occluded_packet(n, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i) blocked[i] = p.tfar[i] < 0.0f;
   reset_packet(p);
 }

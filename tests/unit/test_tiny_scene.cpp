@@ -129,19 +129,17 @@ double check_rays(const cpu::BatchKernels& k, const cpu::TinyScene& tiny, const 
   for (size_t base = 0; base + W <= rays.size(); base += W, total += W) {
     alignas(64) RTCRayHitNt<W> a, b;
     alignas(64) RTCRayNt<W> sa, sb;
-    alignas(64) int valid[W];
     cpu::init_packet_constants(a.ray);
     cpu::init_packet_constants(sa);
     for (int i = 0; i < W; ++i) {
-      valid[i] = -1;
       cpu::set_lane(a.ray, i, rays[base + i].ray, kInfinity);
       a.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
       cpu::set_lane(sa, i, rays[base + i].ray, rays[base + i].tfar);
     }
     b = a;
     sb = sa;
-    cpu::intersect_packet(valid, embree.handle(), &ctx, a);
-    cpu::occluded_packet(valid, embree.handle(), &ctx, sa);
+    cpu::intersect_packet(W, embree.handle(), &ctx, a);  // every lane
+    cpu::occluded_packet(W, embree.handle(), &ctx, sa);
     uint32_t prim[W];
     bool blocked[W];
     // What the test alone leaves to Embree, counted for the query each ray is cast for:
