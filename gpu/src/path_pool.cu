@@ -14,7 +14,8 @@ namespace pb::gpu {
 namespace {
 
 // What a trace kernel wrote into `slot` (mapped host memory: 1 if its iteration has
-// paths, 0 if not), waiting for the GPU to get there; a failure in the stream is reported instead of waiting forever.
+// paths, 0 if not), waiting for the GPU to get there; a failure in the stream is
+// reported instead of waiting forever.
 uint32_t wait_for_plan(cudaStream_t stream, const uint32_t& slot) {
   const volatile uint32_t& v = slot;
   for (uint32_t spins = 0;; ++spins) {
@@ -52,13 +53,13 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
     const WaveStep step{parity, static_cast<unsigned long long>(total), cap, &planned_[it % kPlanSlots]};
     with_traversal_kind(g.bvh, [&](auto kind) {  // trace compiled for the BVH layout
       constexpr int B = decltype(kind)::value;
-      const bool shadows = shadows_.records;
-      if (variance && shadows)
-        launch.launch("trace", k_wf_trace<true, true, B>, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
-      else if (shadows)
-        launch.launch("trace", k_wf_trace<false, true, B>, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
-      else
-        launch.launch("trace", k_wf_trace<false, false, B>, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
+      auto go = [&](auto kernel) {
+        launch.launch("trace", kernel, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
+      };
+      // Without shadow rays nothing in trace touches the film: no variance variant.
+      if (!shadows_.records) go(k_wf_trace<false, false, B>);
+      else if (variance) go(k_wf_trace<true, true, B>);
+      else go(k_wf_trace<false, true, B>);
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;

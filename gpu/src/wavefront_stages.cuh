@@ -73,14 +73,18 @@ __device__ __forceinline__ PathState<float> current_path(const SceneView& s, con
   return st;
 }
 
+// Blocks an SM for the trace kernel: 5 (48 registers) suits the binary and brute-force
+// traversals; the wide one holds a node's 20 words and spills under 48 (ptxas, when
+// closest hits and shadow rays were two kernels: 28 B and 100 B), so it gets 4 (64 registers).
 template <int kKind>
 constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
 
 // The shadow rays the last shade queued (n of them): occlusion, then the radiance to the
-// film (a path that ended) or to the continuing path in `next` (which the next shade reads).
+// film (a path that ended) or to the continuing path's L in `continued`, the buffer the
+// last shade wrote and the next one reads.
 template <bool kVariance, int kKind>
-__device__ __forceinline__ void trace_shadow_rays(const BvhView& bvh, const ShadowSoA& sh, const PathSoA& next, uint32_t n,
-                                                  const FilmDev& film, unsigned long long* discarded) {
+__device__ __forceinline__ void trace_shadow_rays(const BvhView& bvh, const ShadowSoA& sh, const PathSoA& continued,
+                                                  uint32_t n, const FilmDev& film, unsigned long long* discarded) {
   const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
     const uint32_t i = base + lane;
@@ -105,11 +109,11 @@ __device__ __forceinline__ void trace_shadow_rays(const BvhView& bvh, const Shad
         add = true;
         pixel = target & ~kShadowDone;
       } else if (visible) {
-        float4 Lt = next.L[target];
+        float4 Lt = continued.L[target];
         Lt.x = Lt.x + o.w;
         Lt.y = Lt.y + d.w;
         Lt.z = Lt.z + ct.x;
-        next.L[target] = Lt;
+        continued.L[target] = Lt;
       }
     }
     film_add_warp<kVariance>(film, add, pixel, L, discarded);

@@ -59,8 +59,6 @@ struct WaveCounters {
   Stats stats;  // booked by the planning thread, plus the kernels' atomics
 };
 
-
-
 // Warp-aggregated append: one atomic per warp.
 __device__ __forceinline__ uint32_t queue_push(uint32_t* counter) {
   const uint32_t mask = __activemask();
