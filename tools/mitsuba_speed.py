@@ -288,7 +288,8 @@ def emulated_specs(specs, isa):
     for s in specs:
         asked = [f.split("=", 1)[1] for f in s.split("/")[1:] if f.startswith("isa=")]
         if any(x != isa for x in asked):
-            sys.exit(f"--emulate-isa {isa}: spec {s!r} asks for another ISA")
+            print(f"mitsuba_speed.py: error: --emulate-isa {isa}: spec {s!r} asks for another ISA", file=sys.stderr)
+            raise SystemExit(2)  # a bad combination of options, as argparse's own errors
         out.append(s if asked else f"{s}/isa={isa}")
     return list(dict.fromkeys(out))
 
