@@ -12,11 +12,19 @@
 
 namespace pb::cpu {
 
+// Embree counts a hit at tnear <= t; the path step's (and the GPU's watertight test's)
+// hits are at t > 0. With tnear = 0 a ray leaving a corner of two surfaces (offset off
+// one, still in the plane of the other) met that plane at t = 0 or -0 in Embree's
+// arithmetic: a shadow ray blocked on the CPU and clear on the GPU (most of the 13-16
+// pixels of 65,536 at which the CPU's and the GPU's paper-cornell 256x256x800 films
+// differed). The least normal float keeps t > 0 whether or not denormals are flushed.
+constexpr float kEmbreeTnear = std::numeric_limits<float>::min();
+
 // Embree traces in float: a double ray is rounded to float here.
 template <class T> inline void to_embree(const Ray<T>& r, float tfar, RTCRay& e) {
   e.org_x = float(r.o.x); e.org_y = float(r.o.y); e.org_z = float(r.o.z);
   e.dir_x = float(r.d.x); e.dir_y = float(r.d.y); e.dir_z = float(r.d.z);
-  e.tnear = 0.0f;
+  e.tnear = kEmbreeTnear;
   e.tfar = tfar;
   e.time = 0.0f;
   e.mask = 0xFFFFFFFFu;
@@ -27,7 +35,7 @@ template <class T> inline void to_embree(const Ray<T>& r, float tfar, RTCRay& e)
 template <int N, class T> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<T>& r, float tfar) {
   p.org_x[i] = float(r.o.x); p.org_y[i] = float(r.o.y); p.org_z[i] = float(r.o.z);
   p.dir_x[i] = float(r.d.x); p.dir_y[i] = float(r.d.y); p.dir_z[i] = float(r.d.z);
-  p.tnear[i] = 0.0f;
+  p.tnear[i] = kEmbreeTnear;
   p.tfar[i] = tfar;
   p.time[i] = 0.0f;
   p.mask[i] = 0xFFFFFFFFu;
@@ -37,7 +45,7 @@ template <int N, class T> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-// The scene triangle the ray hits first (t >= 0), or RTC_INVALID_GEOMETRY_ID: one
+// The scene triangle the ray hits first (t > 0), or RTC_INVALID_GEOMETRY_ID: one
 // rtcIntersect1, its hit mapped back to the scene's triangle (the layout may be quads).
 template <class T> inline uint32_t closest_triangle(const EmbreeScene& e, RTCIntersectContext& ctx, const Ray<T>& r) {
   RTCRayHit rh;
@@ -79,7 +87,7 @@ inline void occluded_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayNt<
 // Packet fields that stay as set: everything but the ray, tfar and the hit.
 template <int W> void init_packet_constants(RTCRayNt<W>& r) {
   for (int i = 0; i < W; ++i) {
-    r.tnear[i] = 0.0f;
+    r.tnear[i] = kEmbreeTnear;
     r.time[i] = 0.0f;
     r.mask[i] = 0xFFFFFFFFu;
     r.id[i] = 0;
