@@ -7,24 +7,28 @@
 #include <type_traits>
 
 #include "pathbench/common/camera.h"
+#include "pathbench/common/watertight.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "shade_batch.h"
 
 namespace pb::cpu {
 
 // Embree counts a hit at tnear <= t; the path step's (and the GPU's watertight test's)
-// hits are at t > 0. With tnear = 0 a ray leaving a corner of two surfaces (offset off
-// one, still in the plane of the other) met that plane at t = 0 or -0 in Embree's
-// arithmetic: a shadow ray blocked on the CPU and clear on the GPU (most of the 13-16
-// pixels of 65,536 at which the CPU's and the GPU's paper-cornell 256x256x800 films
-// differed). The least normal float keeps t > 0 whether or not denormals are flushed.
-constexpr float kEmbreeTnear = std::numeric_limits<float>::min();
+// hits are at t > ray_t_min(o, d) (watertight.h: hits at the ray's own origin do not
+// count). Embree gets that as tnear, computed from the float ray Embree sees. With
+// tnear = 0 a ray leaving a corner of two surfaces (offset off one, still in the plane of
+// the other) met that plane at t = 0 or -0 in Embree's arithmetic: a shadow ray blocked on
+// the CPU and clear on the GPU (most of the 13-16 pixels of 65,536 at which the CPU's and
+// the GPU's paper-cornell 256x256x800 films differed).
+inline float embree_tnear(float ox, float oy, float oz, float dx, float dy, float dz) {
+  return ray_t_min(Vec3f{ox, oy, oz}, Vec3f{dx, dy, dz});
+}
 
 // Embree traces in float: a double ray is rounded to float here.
 template <class T> inline void to_embree(const Ray<T>& r, float tfar, RTCRay& e) {
   e.org_x = float(r.o.x); e.org_y = float(r.o.y); e.org_z = float(r.o.z);
   e.dir_x = float(r.d.x); e.dir_y = float(r.d.y); e.dir_z = float(r.d.z);
-  e.tnear = kEmbreeTnear;
+  e.tnear = embree_tnear(e.org_x, e.org_y, e.org_z, e.dir_x, e.dir_y, e.dir_z);
   e.tfar = tfar;
   e.time = 0.0f;
   e.mask = 0xFFFFFFFFu;
@@ -35,7 +39,7 @@ template <class T> inline void to_embree(const Ray<T>& r, float tfar, RTCRay& e)
 template <int N, class T> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<T>& r, float tfar) {
   p.org_x[i] = float(r.o.x); p.org_y[i] = float(r.o.y); p.org_z[i] = float(r.o.z);
   p.dir_x[i] = float(r.d.x); p.dir_y[i] = float(r.d.y); p.dir_z[i] = float(r.d.z);
-  p.tnear[i] = kEmbreeTnear;
+  p.tnear[i] = embree_tnear(p.org_x[i], p.org_y[i], p.org_z[i], p.dir_x[i], p.dir_y[i], p.dir_z[i]);
   p.tfar[i] = tfar;
   p.time[i] = 0.0f;
   p.mask[i] = 0xFFFFFFFFu;
@@ -64,7 +68,12 @@ template <class T> inline bool occluded(const EmbreeScene& e, RTCIntersectContex
 }
 
 // Packets of 8 or 16 rays (the batched path step's widths: AVX2, AVX-512), lanes [0, n)
-// active: every caller fills its packet from lane 0.
+// active: every caller fills its packet from lane 0. The shading kernels write the rays'
+// arrays directly, so each call sets the active lanes' tnear from their rays first.
+template <int W> void set_tnear(int n, RTCRayNt<W>& p) {
+  for (int i = 0; i < n; ++i)
+    p.tnear[i] = embree_tnear(p.org_x[i], p.org_y[i], p.org_z[i], p.dir_x[i], p.dir_y[i], p.dir_z[i]);
+}
 template <int W> struct LaneMask {
   alignas(64) int valid[W];
   explicit LaneMask(int n) {
@@ -72,22 +81,26 @@ template <int W> struct LaneMask {
   }
 };
 inline void intersect_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<8>& p) {
+  set_tnear(n, p.ray);
   rtcIntersect8(LaneMask<8>(n).valid, s, c, reinterpret_cast<RTCRayHit8*>(&p));
 }
 inline void intersect_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayHitNt<16>& p) {
+  set_tnear(n, p.ray);
   rtcIntersect16(LaneMask<16>(n).valid, s, c, reinterpret_cast<RTCRayHit16*>(&p));
 }
 inline void occluded_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayNt<8>& p) {
+  set_tnear(n, p);
   rtcOccluded8(LaneMask<8>(n).valid, s, c, reinterpret_cast<RTCRay8*>(&p));
 }
 inline void occluded_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayNt<16>& p) {
+  set_tnear(n, p);
   rtcOccluded16(LaneMask<16>(n).valid, s, c, reinterpret_cast<RTCRay16*>(&p));
 }
 
 // Packet fields that stay as set: everything but the ray, tfar and the hit.
 template <int W> void init_packet_constants(RTCRayNt<W>& r) {
   for (int i = 0; i < W; ++i) {
-    r.tnear[i] = kEmbreeTnear;
+    r.tnear[i] = 0.0f;  // set per call from the rays (set_tnear)
     r.time[i] = 0.0f;
     r.mask[i] = 0xFFFFFFFFu;
     r.id[i] = 0;

@@ -8,7 +8,7 @@
 // stable_triangle_normal, den and T doubled), then decides with margins instead of
 // Embree's exact comparisons:
 //   inside  all of U, V, W beyond +-m with one sign     outside  some beyond +m, some beyond -m
-//   front   T (sign of den applied) > band               behind   < -band
+//   front   t > tnear (1 + 2^-20) + slack                behind   t < tnear (1 - 2^-20) - slack
 //   before  t < tfar (1 - 2^-20) - slack                 beyond   t > tfar (1 + 2^-20) + slack
 //   grazing |den| within 32x its rounding slack (its sign and size in doubt)
 // A candidate inside, front, before and not grazing is a proven hit: Embree's test accepts
@@ -22,7 +22,8 @@
 // differences: m = 2^-16 E M |D|_1 (E: this triangle's largest edge component, M: a bound
 // on |vertex - origin| over the scene), T's band 2^-20 |v0|_inf (|Ng|_1 + 3 E^2), den's
 // 2^-20 |Ng|_1 |D|_1, t's error (band + t den band) / |den| + 2^-20 t (Embree's rcp).
-// cpu/NOTES.md gives the argument.
+// tnear is the rays' (embree_rays.h: watertight.h's ray_t_min, a few ulps of the origin),
+// compared in T as tfar is. cpu/NOTES.md gives the argument.
 namespace pb::cpu::PB_SIMD_NS {
 
 #if PB_SIMD_LANES == 16
@@ -86,6 +87,11 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   const FV inf = splat(__builtin_inff());
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
   const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
+  // Embree's tnear for these rays (embree_rays.h: ray_t_min, watertight.h), in the same
+  // float operations, and its rounding band as tfar's.
+  const FV omax = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)), dmx = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
+  const FV tnear = select(dmx > 0.0f, 0x1p-21f * omax / dmx, splat(0.0f));
+  const FV tnear_lo = tnear * (1.0f - 0x1p-20f), tnear_hi = tnear * (1.0f + 0x1p-20f);
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   // The plane cull's scale (below): |o|_inf + t_end |d|_inf + the scene's largest
   // coordinate bounds |x| on the segment and |vertex - x|. Shadow rays: t_end = tfar
@@ -143,8 +149,9 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
       z.band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
       z.den_band = 0x1p-20f * ng1 * d1;
       z.grazing = z.abs_den <= 32.0f * z.den_band;  // den's sign and size in doubt
-      z.front = z.Ts > z.band;
-      const IV behind = z.Ts < -z.band;
+      const FV tnear_slack = z.band + z.den_band * tnear;
+      z.front = z.Ts > z.abs_den * tnear_hi + tnear_slack;
+      const IV behind = z.Ts < z.abs_den * tnear_lo - tnear_slack;
       const FV tfar_slack = z.band + z.den_band * tfar_finite;
       z.before = z.Ts < z.abs_den * tfar_lo - tfar_slack;
       const IV beyond = z.Ts > z.abs_den * tfar_hi + tfar_slack;

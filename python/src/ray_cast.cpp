@@ -75,7 +75,7 @@ void validate(const RayBatch& r, Backend backend, bool watertight) {
     if (!(tf >= tn)) throw InputError(fmt::format("tfar[{}] = {}: must be >= tnear ({}) and not NaN", i, tf, tn));
     if (backend == Backend::Bvh && tn != 0.0f)
       throw InputError(fmt::format("tnear[{}] = {}: backend 'bvh' supports tnear = 0 only (its traversal tests "
-                                   "0 < t < tfar)", i, tn));
+                                   "ray_t_min < t < tfar, t_min a few float ulps of the origin: watertight.h)", i, tn));
   }
 }
 

@@ -30,7 +30,7 @@ struct RayBatch {
 
 // Throws InputError naming the first offending ray: a non-finite origin or direction,
 // a zero direction, tnear negative or not finite, tfar NaN or below tnear; and, for
-// the BVH backend, tnear other than 0 (its traversal tests 0 < t < tfar) or
+// the BVH backend, tnear other than 0 (its traversal tests t_min < t < tfar, watertight.h) or
 // watertight = false (its triangle test is always watertight).
 void validate(const RayBatch& rays, Backend backend, bool watertight);
 

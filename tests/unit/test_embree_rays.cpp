@@ -1,8 +1,10 @@
-// The CPU's Embree rays count hits at t > 0, as the path step and the GPU's watertight
-// test do (embree_rays.h, kEmbreeTnear). The rays below are from paper-cornell renders
-// (256x256x800, seed 0) where the CPU's and the GPU's films differed: each leaves a corner
-// of the box, offset off the wall it hit but still exactly in the plane of the other wall,
-// and heads out through that plane. With tnear = 0 Embree met that wall at t = 0 (or -0).
+// The CPU's Embree rays and the GPU's watertight test skip the same hits at the ray's own
+// origin: t <= ray_t_min(o, d) (watertight.h; embree_rays.h sets it as tnear). The rays
+// below are from paper-cornell renders (256x256x800, seeds 0-3) where the CPU's and the
+// GPU's films differed: each leaves a corner of the box, offset off the wall it hit but
+// still exactly in the plane of the other wall, and heads out through that plane. With
+// tnear = 0 Embree met that wall at t = 0 (or -0), and the GPU's test at t = 1e-12 ..
+// 5e-7 where rounding made it positive: blocked or hit on one device, clear on the other.
 #include <gtest/gtest.h>
 
 #include "embree_rays.h"
@@ -42,12 +44,39 @@ TEST(EmbreeRays, AHitAtTZeroDoesNotCount) {
   }
 }
 
-// The same rays through the GPU's traversal (host+device code, run here): clear too.
+// Closest-hit rays (unit directions) that the GPU's test met in the plane they start in
+// (at t = 5e-7, 1.8e-11, 1.3e-11, 5.3e-7) and Embree did not.
+const CornerRay kCornerBounceRays[] = {
+    {{10, 9.99975586f, -2.2639389f}, {0.300628424f, -0.526233315f, -0.795425117f}},    // on x = 10, heading out
+    {{-3.27794838f, 10, -9.99975586f}, {-0.291737974f, -0.297914326f, 0.908920228f}},  // on y = 10
+    {{10, -5.40539646f, -9.99975586f}, {0.574718058f, -0.514556289f, 0.63634187f}},    // on x = 10, heading out
+    {{-10, -9.99975586f, 1.83931351f}, {-0.173614994f, 0.623392761f, -0.762390554f}},  // on x = -10, heading out
+};
+
+// The same rays through the GPU's traversal (host+device code, run here): the shadow rays
+// clear, the bounce rays' closest hits Embree's, never the plane they start in.
 TEST(EmbreeRays, TheGpuTraversalAgrees) {
   const Scene scene = load_scene("paper-cornell");
   const gpu::SceneBvhHost bvh = gpu::build_scene_bvh(scene, gpu::GpuBvhOptions{});
-  for (const CornerRay& r : kCornerShadowRays)
-    EXPECT_FALSE(gpu::occluded(bvh.view(), r.o, r.d, 1.0f));
+  for (const CornerRay& r : kCornerShadowRays) EXPECT_FALSE(gpu::occluded(bvh.view(), r.o, r.d, 1.0f));
+  const auto embree = make_embree_scene(scene, /*watertight=*/true, EmbreeLayout::Triangles);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (const CornerRay& r : kCornerBounceRays) {
+    float t = 0;
+    const uint32_t gpu_prim = gpu::intersect_closest(bvh.view(), r.o, r.d, INFINITY, t);
+    const uint32_t cpu_prim = closest_triangle(*embree, ctx, Ray<float>{r.o, r.d});
+    EXPECT_EQ(gpu_prim == gpu::kNoHit ? RTC_INVALID_GEOMETRY_ID : gpu_prim, cpu_prim)
+        << "origin " << r.o.x << " " << r.o.y << " " << r.o.z;
+    if (gpu_prim != gpu::kNoHit) EXPECT_GT(t, 0.01f) << "a hit at the ray's own origin";
+  }
+}
+
+TEST(EmbreeRays, TMinIsAFewUlpsOfTheOrigin) {
+  EXPECT_EQ(ray_t_min({0, 0, 0}, {0, 0, 1}), 0.0f);
+  EXPECT_EQ(ray_t_min({8, -2, 1}, {0, 0, 1}), 8 * 0x1p-21f);       // 4 ulps of 8
+  EXPECT_EQ(ray_t_min({8, -2, 1}, {0, -4, 1}), 8 * 0x1p-21f / 4);  // t along d: |d|_inf = 4
+  EXPECT_EQ(ray_t_min({1, 2, 3}, {0, 0, 0}), 0.0f);                // no direction: no bound
 }
 
 }  // namespace

@@ -17,12 +17,28 @@
 
 namespace pb {
 
-// Per-ray constants of the shear transform.
+// Per-ray constants of the shear transform, and t_min (below).
 struct WatertightRay {
   Vec3f o;
   int kx, ky, kz;
   float sx, sy, sz;
+  float t_min;
 };
+
+// The least t a hit needs, along the ray's own (unnormalised) direction: about 4 float
+// ulps of the origin's largest coordinate, as a distance. A ray leaving a corner of two
+// surfaces is offset off the one it hit (ray_offset.h) but still lies in the plane of the
+// other; heading out through that plane it meets it at t = 0 exactly, which rounding
+// turns into a tiny t of either sign (1e-12 .. 5e-7 seen in paper-cornell), hit or not
+// by the noise of each device's arithmetic. Such hits are the ray's own origin, not
+// geometry in front of it: every triangle test here and the CPU's Embree rays
+// (tnear, cpu/src/embree_rays.h) skip them alike. Far below the origin offset (256
+// ulps), so no surface the offset cleared is ever skipped.
+PB_HD float ray_t_min(const Vec3f& o, const Vec3f& d) {
+  const float omax = pmax(pmax(std::fabs(o.x), std::fabs(o.y)), std::fabs(o.z));
+  const float dmax = pmax(pmax(std::fabs(d.x), std::fabs(d.y)), std::fabs(d.z));
+  return dmax > 0.0f ? 0x1p-21f * omax / dmax : 0.0f;
+}
 
 PB_HD float wt_axis(const Vec3f& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
@@ -47,6 +63,7 @@ PB_HD WatertightRay make_watertight_ray(const Vec3f& o, const Vec3f& d) {
   r.sx = wt_axis(d, kx) / dz;
   r.sy = wt_axis(d, ky) / dz;
   r.sz = 1.0f / dz;
+  r.t_min = ray_t_min(o, d);
   return r;
 }
 
@@ -65,7 +82,7 @@ PB_HD float plane_distance(const Vec3f& o, const Vec3f& d, const Vec3f& a, const
   return float(num / den);
 }
 
-// Tests the triangle (a, b, c) for a hit with 0 < t < t_max (t along the ray's own,
+// Tests the triangle (a, b, c) for a hit with r.t_min < t < t_max (t along the ray's own,
 // unnormalised direction). On a hit returns true and sets t.
 PB_HD bool intersect_watertight(const WatertightRay& r, const Vec3f& a, const Vec3f& b, const Vec3f& c,
                                 float t_max, float& t) {
@@ -87,14 +104,14 @@ PB_HD bool intersect_watertight(const WatertightRay& r, const Vec3f& a, const Ve
   const float det = U + V + W;
   if (det == 0.0f) return false;
   const float T = U * (r.sz * Az) + V * (r.sz * Bz) + W * (r.sz * Cz);
-  // 0 < T / det < t_max without dividing (both sides of the sign of det).
+  // t_min < T / det < t_max without dividing (both sides of the sign of det).
   if (det > 0.0f) {
-    if (!(T > 0.0f) || !(T < t_max * det)) return false;
+    if (!(T > r.t_min * det) || !(T < t_max * det)) return false;
   } else {
-    if (!(T < 0.0f) || !(T > t_max * det)) return false;
+    if (!(T < r.t_min * det) || !(T > t_max * det)) return false;
   }
   t = T / det;
-  return t > 0.0f && t < t_max;
+  return t > r.t_min && t < t_max;
 }
 
 }  // namespace pb
