@@ -90,7 +90,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   // Embree's tnear for these rays (embree_rays.h: ray_t_min, watertight.h), in the same
   // float operations, and its rounding band as tfar's.
   const FV omax = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)), dmx = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
-  const FV tnear = select(dmx > 0.0f, 0x1p-21f * omax / dmx, splat(0.0f));
+  const FV tnear = select(dmx > 0.0f, 0x1p-21f * omax * (1.0f / dmx), splat(0.0f));
   const FV tnear_lo = tnear * (1.0f - 0x1p-20f), tnear_hi = tnear * (1.0f + 0x1p-20f);
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   // The plane cull's scale (below): |o|_inf + t_end |d|_inf + the scene's largest

@@ -75,8 +75,13 @@ TEST(EmbreeRays, TheGpuTraversalAgrees) {
 TEST(EmbreeRays, TMinIsAFewUlpsOfTheOrigin) {
   EXPECT_EQ(ray_t_min({0, 0, 0}, {0, 0, 1}), 0.0f);
   EXPECT_EQ(ray_t_min({8, -2, 1}, {0, 0, 1}), 8 * 0x1p-21f);       // 4 ulps of 8
-  EXPECT_EQ(ray_t_min({8, -2, 1}, {0, -4, 1}), 8 * 0x1p-21f / 4);  // t along d: |d|_inf = 4
+  EXPECT_EQ(ray_t_min({8, -2, 1}, {0, -4, 1}), 8 * 0x1p-21f * 0.25f);  // t along d: |d|_inf = 4
   EXPECT_EQ(ray_t_min({1, 2, 3}, {0, 0, 0}), 0.0f);                // no direction: no bound
+  // The triangle test's own evaluation (from the sheared ray) is the same number.
+  for (const Vec3f d : {Vec3f{0.3f, -0.7f, 0.2f}, Vec3f{-5, 5, 1}, Vec3f{1e-3f, 2e-3f, -2e-3f}, Vec3f{0, 0, -3}}) {
+    const Vec3f o{9.99975586f, -3.5f, 21.9995117f};
+    EXPECT_EQ(t_min_of(make_watertight_ray(o, d)), ray_t_min(o, d));
+  }
 }
 
 }  // namespace
