@@ -7,8 +7,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
+#include "film_agreement.h"
 #include "pathbench/common/scene_library.h"
+#include "pathbench/cpu/embree_facts.h"
 #include "pathbench/gpu/host_tracer.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
@@ -72,19 +76,35 @@ TEST(HostGpuTracer, RendersWhatTheCpuTracerRenders) {
     const Film host = host_film(scene, HostGpuTracer(scene), s, {{0, 0, 0, 16}}, hr);
     Film cpu(s.width, s.height, false);
     run::render(scene, s, cpu, cr);
-    const auto a = host.mean(), b = cpu.mean();
-    size_t within = 0;
-    for (size_t p = 0; p < a.size() / 3; ++p) {
-      bool ok = true;
-      for (int k = 0; k < 3; ++k) {
-        const double x = a[p * 3 + k], y = b[p * 3 + k];
-        ok = ok && std::fabs(x - y) <= 1e-4 * std::max({std::fabs(x), std::fabs(y), 1e-30});
-      }
-      within += ok;
-    }
-    EXPECT_GE(double(within), 0.99 * double(a.size() / 3)) << name;
+    EXPECT_GE(test::film_agreement(host, cpu).share_within(), 0.99) << name;
     EXPECT_EQ(hr.paths, cr.paths) << name;
   }
+}
+
+// Issue 15's frame: paper-cornell 256x256x800, 2 bounces, nee, seed 0. The GPU's samples
+// (computed here; HostGpuTracer.SameFilmAsTheGpu holds them to the GPU's film byte for byte)
+// against the CPU tracer's: >= 99.99 % of the pixels within 1e-4. What parts them is a few
+// single samples whose rays meet a box corner line or the light's edge, where Embree's
+// triangle test and the watertight test round differently; before hits at a ray's own
+// origin were skipped alike on both devices (watertight.h, ray_t_min) it was 99.986 %
+// (results/nvidia-h100-80gb-hbm3/cpu-gpu-t-min-e4b4b93). The CPU's answers are Embree's,
+// whose kernels round by ISA: 65,531 of 65,536 pixels with its AVX2 and AVX-512 kernels
+// (AMD EPYC, Xeon), 65,529 (99.989 %) with its SSE kernels (capped by tools/isa_cap), so
+// below AVX2 the bound is 99.98 %. ~40 s on 2 cores: unit_slow.
+TEST(HostGpuTracerSlow, PaperFrameWithinAcceptance) {
+  const Scene scene = load_scene("paper-cornell");
+  RenderSettings s = settings(256, 800);
+  s.seed = 0;
+  RunReport hr, cr;
+  const Film host = host_film(scene, HostGpuTracer(scene), s, {{0, 0, 0, 800}}, hr);
+  Film cpu(s.width, s.height, false);
+  run::render(scene, s, cpu, cr);
+  const test::FilmAgreement a = test::film_agreement(host, cpu);
+  const std::string embree_isa = cpu::embree_tbb_facts()["embree"].value("isa_derived", "unknown");
+  std::printf("[ INFO     ] paper-cornell 256x256x800 (Embree %s): %.4f%% of pixels within 1e-4 (%zu of %zu), %zu differ, "
+              "worst %.3g\n", embree_isa.c_str(), 100.0 * a.share_within(), a.within, a.pixels, a.differ, a.worst);
+  EXPECT_GE(a.share_within(), embree_isa == "avx2" || embree_isa == "avx512" ? 0.9999 : 0.9998);
+  EXPECT_EQ(hr.paths, cr.paths);
 }
 
 }  // namespace
