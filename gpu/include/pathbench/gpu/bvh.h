@@ -233,10 +233,12 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
 
 }  // namespace detail
 
-// Closest hit (kAnyHit = false) or any hit (true) for 0 < t < t_max along the ray's
-// own direction (need not be unit length). Returns the scene triangle id, or kNoHit;
-// t_hit receives the distance of a hit. kWatertight = false swaps the triangle test for
-// Moeller-Trumbore (the paper's; the accuracy study's comparison).
+// Closest hit (kAnyHit = false) or any hit (true) for ray_t_min < t < t_max (watertight.h:
+// a few float ulps of the origin, so that a hit at the ray's own origin counts on no
+// device) along the ray's own direction (need not be unit length). Returns the scene
+// triangle id, or kNoHit; t_hit receives the distance of a hit. kWatertight = false swaps
+// the triangle test for Moeller-Trumbore (the paper's; the accuracy study's comparison;
+// it keeps 0 < t).
 // kExact: the view's exact_ties read at run time (-1), or known at compile time (0, 1):
 // the hot kernels are compiled for one or the other, since a run-time flag keeps the tie
 // compare's registers live in every kernel (ptxas, sm_90, k_pixel: 48 -> 60 bytes of

@@ -102,7 +102,7 @@ void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings&
 uint64_t default_paths_in_flight();
 
 // Traversal on the device, for tests: closest hit (or any hit when `any_hit`) for each
-// ray with 0 < t < t_max.
+// ray with ray_t_min < t < t_max (watertight.h).
 struct TraceQuery {
   Vec3f o, d;
   float t_max;
