@@ -39,7 +39,7 @@ template <class T> inline void to_embree(const Ray<T>& r, float tfar, RTCRay& e)
 template <int N, class T> inline void set_lane(RTCRayNt<N>& p, int i, const Ray<T>& r, float tfar) {
   p.org_x[i] = float(r.o.x); p.org_y[i] = float(r.o.y); p.org_z[i] = float(r.o.z);
   p.dir_x[i] = float(r.d.x); p.dir_y[i] = float(r.d.y); p.dir_z[i] = float(r.d.z);
-  p.tnear[i] = embree_tnear(p.org_x[i], p.org_y[i], p.org_z[i], p.dir_x[i], p.dir_y[i], p.dir_z[i]);
+  // tnear: set by intersect_packet / occluded_packet for every active lane (set_tnear).
   p.tfar[i] = tfar;
   p.time[i] = 0.0f;
   p.mask[i] = 0xFFFFFFFFu;

@@ -34,9 +34,8 @@ struct WatertightRay {
 // (tnear, cpu/src/embree_rays.h) skip them alike. Far below the origin offset (256
 // ulps), so no surface the offset cleared is ever skipped.
 PB_HD float ray_t_min(const Vec3f& o, const Vec3f& d) {
-  const float omax = pmax(pmax(std::fabs(o.x), std::fabs(o.y)), std::fabs(o.z));
-  const float dmax = pmax(pmax(std::fabs(d.x), std::fabs(d.y)), std::fabs(d.z));
-  return dmax > 0.0f ? 0x1p-21f * omax * (1.0f / dmax) : 0.0f;
+  const float dmax = max_component(vabs(d));
+  return dmax > 0.0f ? 0x1p-21f * max_component(vabs(o)) * (1.0f / dmax) : 0.0f;
 }
 
 PB_HD float wt_axis(const Vec3f& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
@@ -69,8 +68,7 @@ PB_HD WatertightRay make_watertight_ray(const Vec3f& o, const Vec3f& d) {
 // axis is kz. Evaluated where a hit is found rather than kept per ray: one more live
 // register cost the GPU's megakernel spills (ptxas sm_90: 48 -> 56 bytes stored) and 5 %.
 PB_HD float t_min_of(const WatertightRay& r) {
-  const float omax = pmax(pmax(std::fabs(r.o.x), std::fabs(r.o.y)), std::fabs(r.o.z));
-  return 0x1p-21f * omax * std::fabs(r.sz);
+  return 0x1p-21f * max_component(vabs(r.o)) * std::fabs(r.sz);
 }
 
 // The distance along d from o to the plane of (a, b, c), rounded once from double.
