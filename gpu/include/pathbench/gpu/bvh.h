@@ -182,6 +182,29 @@ PB_HD SlabRay make_slab_ray(const Vec3f& o, const Vec3f& d) {
 // the builders also pad every box by a few ulps of the scene's scale.
 constexpr float kFarScale = 1.0000004f;
 
+// The slab test's min and max: one FMNMX each on the device, where pmin / pmax (a < b ?
+// a : b) compile to a compare and a select, two instructions (16 more a binary node: a
+// sixth of the paper-cornell megakernel's node loop, ncu source counters). On the host
+// the ternary, which is what x86's minss / maxss compute. The two differ only where an
+// operand is NaN, and slab distances of a finite ray are not: safe_inverse keeps 1/d
+// finite, so fmadd of a box plane is finite or the infinite oi. Signed zeros may come
+// out differently, but the traversal only compares these values, where -0 == +0: every
+// decision, and so every hit, is the same as with pmin / pmax.
+PB_HD float slab_min(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return fminf(a, b);
+#else
+  return pmin(a, b);
+#endif
+}
+PB_HD float slab_max(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return fmaxf(a, b);
+#else
+  return pmax(a, b);
+#endif
+}
+
 }  // namespace detail
 
 namespace detail {
@@ -209,9 +232,9 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
         const float tx0 = fmadd(x[2 * c], inv.x, oi.x), tx1 = fmadd(x[2 * c + 1], inv.x, oi.x);
         const float ty0 = fmadd(y[2 * c], inv.y, oi.y), ty1 = fmadd(y[2 * c + 1], inv.y, oi.y);
         const float tz0 = fmadd(z[2 * c], inv.z, oi.z), tz1 = fmadd(z[2 * c + 1], inv.z, oi.z);
-        tn[c] = pmax(pmax(pmin(tx0, tx1), pmin(ty0, ty1)), pmax(pmin(tz0, tz1), 0.0f));
-        tf[c] = pmin(pmin(pmax(tx0, tx1), pmax(ty0, ty1)), pmax(tz0, tz1)) * kFarScale;
-        tf[c] = pmin(tf[c], t);
+        tn[c] = slab_max(slab_max(slab_min(tx0, tx1), slab_min(ty0, ty1)), slab_max(slab_min(tz0, tz1), 0.0f));
+        tf[c] = slab_min(slab_min(slab_max(tx0, tx1), slab_max(ty0, ty1)), slab_max(tz0, tz1)) * kFarScale;
+        tf[c] = slab_min(tf[c], t);
       }
       const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
       if (h0 && h1) {

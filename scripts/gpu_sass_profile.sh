@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Where a GPU kernel's instructions go, SASS instruction by SASS instruction: Nsight
+# Compute's source counters (executed instructions, thread-level executed instructions and
+# sampled warp stalls per SASS address) for the pixel megakernel on paper-cornell and the
+# raw incoherent closest-hit ray casts on the same scene. Runs on the GPU host, after
+# gpu/run_on_device.sh's build (BUILD_DIR/bin/pathbench, pathbench-bench);
+# tools/sass_profile.py turns the CSVs into a table per source line and per SASS opcode.
+#   scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR
+# --clock-control none as in scripts/gpu_roofline.sh. One launch per kernel: the counts
+# are per launch (pixel: 256x256 x SPP samples; ray casts: the bench's stored rays).
+set -uo pipefail
+build=${1:?usage: scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
+out=${2:?usage: scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
+spp=${SPP:-16}
+mkdir -p "$out"
+sections=(--section SourceCounters --section WarpStateStats --section InstructionStats --section LaunchStats
+          --section Occupancy --section ComputeWorkloadAnalysis --section SpeedOfLight)
+profile() {  # name, kernel regex, then the command
+  local name=$1 kernel=$2; shift 2
+  echo "== $name"
+  timeout 300 ncu --clock-control none --import-source yes "${sections[@]}" -k "regex:$kernel" --launch-count 1 \
+    -f -o "$out/$name" "$@" > "$out/$name.log" 2>&1
+  echo "profile rc=$?"
+  ncu -i "$out/$name.ncu-rep" --page source --csv --print-source sass > "$out/$name-sass.csv" 2> "$out/$name-sass.err"
+  echo "sass page rc=$? $(wc -l < "$out/$name-sass.csv") lines"
+  ncu -i "$out/$name.ncu-rep" --page source --csv --print-source cuda > "$out/$name-cuda.csv" 2> "$out/$name-cuda.err"
+  echo "cuda page rc=$? $(wc -l < "$out/$name-cuda.csv") lines"
+  ncu -i "$out/$name.ncu-rep" --page details --csv > "$out/$name-details.csv" 2> "$out/$name-details.err"
+  echo "details rc=$? $(wc -l < "$out/$name-details.csv") lines"
+}
+profile pixel k_pixel "$build/bin/pathbench" render --device gpu --quiet --scene paper-cornell --width 256 --height 256 \
+  --spp "$spp" --bounces 2 --sampling nee --strategy pixel
+profile raycast k_trace "$build/bin/pathbench-bench" --preset paper \
+  --benchmark_filter='^raycast/gpu/closest/incoherent/paper-cornell$' --benchmark_min_time=0.01s
