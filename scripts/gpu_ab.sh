@@ -4,8 +4,10 @@
 # time after the warm-up frame), and each film's hash is kept; then the raw ray-cast rows
 # of pathbench-bench for both. Prints, per case, the median device ms of A and B, B/A,
 # and whether every film of B hashed as A's (a change meant to keep the images).
+# NO_RAYCAST=1 leaves out the ray-cast rows.
 #   scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]
-# Cases: CASES (a file of "name | pathbench render options" lines), else the paper's
+# Cases: CASES (a file of "name | [VAR=value ...] pathbench render options" lines: leading
+# VAR=value words are set in the environment of both builds' runs), else the paper's
 # frame on paper-cornell (pixel, wavefront, paper-queue; nee and uniform) and
 # paper-cornell-ico:8 (pixel).
 set -uo pipefail
@@ -28,11 +30,15 @@ nvidia-smi --query-gpu=name,driver_version,temperature.gpu,clocks.sm,clocks.max.
 for round in $(seq 1 "$rounds"); do
   while IFS='|' read -r name opts; do
     name=$(echo $name)
+    opts_env="" opts_args=""
+    for w in $opts; do
+      if [ -z "$opts_args" ] && [[ $w =~ ^[A-Z_][A-Z0-9_]*= ]]; then opts_env+=" $w"; else opts_args+=" $w"; fi
+    done
     for side in A B; do
       dir=$a; [ $side = B ] && dir=$b
       film="$out/films/$name-$side.pfm"
       # shellcheck disable=SC2086
-      timeout 300 "$dir/bin/pathbench" render --device gpu --quiet $opts --out "$film" --report "$out/r.json" \
+      timeout 300 env $opts_env "$dir/bin/pathbench" render --device gpu --quiet $opts_args --out "$film" --report "$out/r.json" \
         > "$out/last.log" 2>&1 || { echo "$name $side failed: $(tail -2 "$out/last.log")"; continue; }
       ms=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['device_seconds']*1e3)" "$out/r.json")
       echo -e "$round\t$name\t$side\t$ms\t$(sha256sum < "$film" | cut -c1-16)" >> "$tsv"
@@ -42,6 +48,7 @@ done
 nvidia-smi --query-gpu=name,temperature.gpu,clocks.sm,clocks_throttle_reasons.active --format=csv \
   > "$out/gpu-state-after.csv" 2>&1
 for side in A B; do
+  [ -n "${NO_RAYCAST:-}" ] && break  # NO_RAYCAST=1: renders only
   dir=$a; [ $side = B ] && dir=$b
   timeout 300 "$dir/bin/pathbench-bench" --preset paper --benchmark_filter='^raycast/gpu/' --benchmark_repetitions=3 \
     --benchmark_out="$out/raycast-$side.json" --benchmark_out_format=json > "$out/raycast-$side.log" 2>&1
