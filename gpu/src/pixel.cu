@@ -46,7 +46,8 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
 // kMinBlocks: blocks of 256 an SM must fit, registers capped to match (1: the compiler's
 // choice, 91 registers and 2 blocks for the float watertight kernel). Measured on an H100
 // (gpu/NOTES.md, "Occupancy of the megakernel"): 3 blocks suit scenes whose BVH sits in
-// L1 (issue bound), 5 (48 registers, spills) scenes that miss to L2 (latency bound).
+// L1 (issue bound), kPixelLatencyBlocks (8: 32 registers, spills) scenes that miss to L2
+// (latency bound).
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks>
 __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
                                                FilmDev film, Stats* stats) {
@@ -75,11 +76,13 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   const std::string v = env ? env : "auto";
   if (v == "3") return {3, "PATHBENCH_GPU_PIXEL_BLOCKS=3"};
-  if (v == "5") return {5, "PATHBENCH_GPU_PIXEL_BLOCKS=5"};
+  if (v == std::to_string(kPixelLatencyBlocks))
+    return {kPixelLatencyBlocks, "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   if (v != "auto")
-    throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or 5", v));
+    throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {}", v, kPixelLatencyBlocks));
   if (g.bvh_tris >= kPixelLatencyBoundTris)
-    return {5, fmt::format("auto: {} triangles >= {} (latency bound: more warps)", g.bvh_tris, kPixelLatencyBoundTris)};
+    return {kPixelLatencyBlocks,
+            fmt::format("auto: {} triangles >= {} (latency bound: more warps)", g.bvh_tris, kPixelLatencyBoundTris)};
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
 
@@ -100,7 +103,8 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
     else
       with_traversal_kind(g.bvh, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
-        if (min_blocks == 5) variance ? go(k_pixel<true, K, float, true, B, 5>) : go(k_pixel<false, K, float, true, B, 5>);
+        constexpr int L = kPixelLatencyBlocks;
+        if (min_blocks == L) variance ? go(k_pixel<true, K, float, true, B, L>) : go(k_pixel<false, K, float, true, B, L>);
         else variance ? go(k_pixel<true, K, float, true, B, 3>) : go(k_pixel<false, K, float, true, B, 3>);
       });
   });

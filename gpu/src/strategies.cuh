@@ -38,12 +38,17 @@ struct ShadowUse {
 // The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
 // and the megakernel waits on memory (more warps hide it); below, it is issue bound.
-// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|5 overrides it (a bad value: InputError).
+// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 overrides it (a bad value: InputError).
 struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
+// The latency-bound build: 8 blocks (32 registers, ~700 bytes of spills) since the slab
+// test's min/max became one instruction each; interleaved on an H200 against 5 blocks
+// (48 registers): ico:5 35.81 -> 35.69 ms, ico:7 43.12 -> 42.92, ico:8 49.08 -> 47.96
+// (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/pixel-occupancy-8).
+constexpr int kPixelLatencyBlocks = 8;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
 // The pixel megakernel over `total` samples (spp per pixel), compiled for the scene's
