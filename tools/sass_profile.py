@@ -2,11 +2,11 @@
 """Where a kernel's instructions go, from Nsight Compute's SASS source page.
 
 Reads the CSV that `ncu -i REPORT --page source --csv --print-source sass` writes
-(scripts/gpu_sass_profile.sh makes it) and prints, per unit of work (--per: e.g. the
-launch's samples divided by 32, for warp instructions per warp of samples):
+(scripts/gpu_sass_profile.sh makes it; plain or gzipped) and prints, per unit of work (--per:
+e.g. the launch's samples divided by 32, for warp instructions per warp of samples):
   - the executed warp instructions and the sampled warp stalls by opcode,
   - the hottest straight-line blocks (runs of instructions with one execution count),
-    with their first instructions, so a block can be found in the disassembly.
+    with their first instruction, so a block can be found in the disassembly.
 
   tools/sass_profile.py pixel-sass.csv[.gz] --per 2048 [--top 25]
 """
@@ -17,71 +17,118 @@ import gzip
 import io
 import re
 import sys
+from dataclasses import dataclass
+
+STALL_COLUMN = "Warp Stall Sampling (All Samples)"
 
 
-def read_rows(path):
-    raw = gzip.open(path, "rt") if path.endswith(".gz") else open(path, newline="")
-    rows = list(csv.reader(io.StringIO(raw.read())))
+@dataclass
+class Instruction:
+    text: str        # the SASS line, predicate guard included
+    executed: float  # warp-level executions in the profiled launch
+    stalls: float    # sampled warp stalls at this instruction (0 where not sampled)
+
+
+@dataclass
+class Block:
+    start: int  # index of its first instruction
+    end: int    # index of its last instruction
+    executed: float
+    stalls: float
+    first: str
+
+    @property
+    def length(self):
+        return self.end - self.start + 1
+
+    @property
+    def instructions(self):
+        return self.length * self.executed
+
+
+def read_instructions(path):
+    """The SASS instructions of the CSV, in address order. Raises ValueError when the file
+    has no 'Source' and 'Instructions Executed' header row (not a source page)."""
+    raw = gzip.open(path, "rt") if str(path).endswith(".gz") else open(path, newline="")
+    with raw:
+        rows = list(csv.reader(io.StringIO(raw.read())))
     for i, r in enumerate(rows):
         if "Instructions Executed" in r and "Source" in r:
-            hdr = r
-            body = rows[i + 1:]
+            hdr, body = r, rows[i + 1:]
             break
     else:
-        sys.exit(f"{path}: no 'Instructions Executed' / 'Source' header (not an ncu source page CSV?)")
-    col = {name: hdr.index(name) for name in ("Source", "Instructions Executed")}
-    stall = hdr.index("Warp Stall Sampling (All Samples)") if "Warp Stall Sampling (All Samples)" in hdr else None
+        raise ValueError(f"{path}: no 'Source' / 'Instructions Executed' header row "
+                         "(not the CSV of ncu --page source --print-source sass?)")
+    src, ex = hdr.index("Source"), hdr.index("Instructions Executed")
+    st = hdr.index(STALL_COLUMN) if STALL_COLUMN in hdr else None
     out = []
     for r in body:
-        if len(r) <= col["Instructions Executed"]:
+        if len(r) <= max(src, ex):
             continue
-        text = r[col["Source"]].strip()
-        n = float(r[col["Instructions Executed"]] or 0)
-        s = float(r[stall] or 0) if stall is not None else 0.0
-        out.append((text, n, s))
+        stalls = float(r[st] or 0) if st is not None and len(r) > st else 0.0
+        out.append(Instruction(r[src].strip(), float(r[ex] or 0), stalls))
     return out
 
 
 def opcode(text):
-    t = re.sub(r"^@!?U?P\w+\s+", "", text)  # drop a predicate guard
+    """The opcode of a SASS line, without its predicate guard (`@!P0 BRA x` -> `BRA`)."""
+    t = re.sub(r"^@!?U?P\w+\s+", "", text.strip())
     return t.split()[0] if t else "?"
 
 
-def main():
+def by_opcode(instructions):
+    """{opcode: (executed, stalls)}, most executed first."""
+    ex, st = collections.Counter(), collections.Counter()
+    for ins in instructions:
+        ex[opcode(ins.text)] += ins.executed
+        st[opcode(ins.text)] += ins.stalls
+    return {op: (n, st[op]) for op, n in ex.most_common()}
+
+
+def hot_blocks(instructions):
+    """Runs of consecutive instructions with one execution count, most instructions first."""
+    blocks = []
+    for i, ins in enumerate(instructions):
+        if blocks and blocks[-1].executed == ins.executed and blocks[-1].end == i - 1:
+            blocks[-1].end = i
+            blocks[-1].stalls += ins.stalls
+        else:
+            blocks.append(Block(i, i, ins.executed, ins.stalls, ins.text))
+    return sorted(blocks, key=lambda b: -b.instructions)
+
+
+def report(instructions, per=1.0, top=25):
+    total = sum(i.executed for i in instructions)
+    if total == 0:
+        raise ValueError("no executed instructions")
+    stalls = sum(i.stalls for i in instructions) or 1.0
+    lines = [f"{len(instructions)} SASS instructions; {total / per:.1f} executed warp instructions per unit "
+             f"({total:.0f} in all), {stalls:.0f} stall samples", "",
+             f"{'opcode':24s} {'per unit':>9s} {'inst %':>7s} {'stall %':>8s}"]
+    for op, (n, s) in list(by_opcode(instructions).items())[:top]:
+        lines.append(f"{op:24s} {n / per:9.1f} {n / total * 100:7.1f} {s / stalls * 100:8.1f}")
+    lines += ["", f"{'block':>11s} {'len':>4s} {'x per unit':>10s} {'share':>6s} {'stall %':>8s}  first instruction"]
+    for b in hot_blocks(instructions)[:top]:
+        lines.append(f"{b.start:5d}-{b.end:5d} {b.length:4d} {b.executed / per:10.3f} "
+                     f"{b.instructions / total * 100:5.1f}% {b.stalls / stalls * 100:8.1f}  {b.first[:60]}")
+    return "\n".join(lines)
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("csv")
     ap.add_argument("--per", type=float, default=1.0, help="divide counts by this (units of work in the launch)")
     ap.add_argument("--top", type=int, default=25)
-    a = ap.parse_args()
-    rows = read_rows(a.csv)
-    total = sum(n for _, n, _ in rows)
-    stalls = sum(s for _, _, s in rows) or 1.0
-    if total == 0:
-        sys.exit(f"{a.csv}: no executed instructions")
-    print(f"{len(rows)} SASS instructions; {total / a.per:.1f} executed warp instructions per unit "
-          f"({total:.0f} in all), {stalls:.0f} stall samples")
-    by_op, st_op = collections.Counter(), collections.Counter()
-    for text, n, s in rows:
-        by_op[opcode(text)] += n
-        st_op[opcode(text)] += s
-    print(f"\n{'opcode':24s} {'per unit':>9s} {'inst %':>7s} {'stall %':>8s}")
-    for op, n in by_op.most_common(a.top):
-        print(f"{op:24s} {n / a.per:9.1f} {n / total * 100:7.1f} {st_op[op] / stalls * 100:8.1f}")
-    blocks, cur = [], None
-    for i, (text, n, s) in enumerate(rows):
-        if cur and cur["n"] == n:
-            cur["end"] = i
-            cur["stall"] += s
-        else:
-            cur = {"start": i, "end": i, "n": n, "stall": s, "first": text}
-            blocks.append(cur)
-    blocks.sort(key=lambda b: -(b["end"] - b["start"] + 1) * b["n"])
-    print(f"\n{'block':>11s} {'len':>4s} {'x per unit':>10s} {'share':>6s} {'stall %':>8s}  first instruction")
-    for b in blocks[:a.top]:
-        length = b["end"] - b["start"] + 1
-        print(f"{b['start']:5d}-{b['end']:5d} {length:4d} {b['n'] / a.per:10.3f} {length * b['n'] / total * 100:5.1f}% "
-              f"{b['stall'] / stalls * 100:8.1f}  {b['first'][:60]}")
+    a = ap.parse_args(argv)
+    if a.per <= 0:
+        ap.error("--per must be positive")
+    try:
+        print(report(read_instructions(a.csv), a.per, a.top))
+    except (OSError, ValueError) as e:
+        print(f"sass_profile: {e}", file=sys.stderr)
+        return 2
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
