@@ -29,7 +29,7 @@ nvidia-smi --query-gpu=name,driver_version,temperature.gpu,clocks.sm,clocks.max.
   --format=csv > "$out/gpu-state-before.csv" 2>&1
 for round in $(seq 1 "$rounds"); do
   while IFS='|' read -r name opts; do
-    name=$(echo $name)
+    name=${name//[[:space:]]/}  # names have no spaces: trim the padding around "|"
     opts_env="" opts_args=""
     for w in $opts; do
       if [ -z "$opts_args" ] && [[ $w =~ ^[A-Z_][A-Z0-9_]*= ]]; then opts_env+=" $w"; else opts_args+=" $w"; fi
