@@ -6,8 +6,10 @@
 # gpu/run_on_device.sh's build (BUILD_DIR/bin/pathbench, pathbench-bench);
 # tools/sass_profile.py turns the CSVs into a table per source line and per SASS opcode.
 #   scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR
-# --clock-control none as in scripts/gpu_roofline.sh. One launch per kernel: the counts
-# are per launch (pixel: 256x256 x SPP samples; ray casts: the bench's stored rays).
+# --clock-control none as in scripts/gpu_roofline.sh. One launch per kernel, after the first
+# (a render's first launch is its warm-up frame, one sample a pixel, whose warps span 32
+# pixels; the bench's is its warm-up): the counts are per launch (pixel: 256x256 x SPP
+# samples; ray casts: the bench's stored rays). SKIP=0 profiles the first launch instead.
 set -uo pipefail
 build=${1:?usage: scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
 out=${2:?usage: scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
@@ -18,7 +20,8 @@ sections=(--section SourceCounters --section WarpStateStats --section Instructio
 profile() {  # name, kernel regex, then the command
   local name=$1 kernel=$2; shift 2
   echo "== $name"
-  timeout 300 ncu --clock-control none --import-source yes "${sections[@]}" -k "regex:$kernel" --launch-count 1 \
+  timeout 300 ncu --clock-control none --import-source yes "${sections[@]}" -k "regex:$kernel" \
+    --launch-skip "${SKIP:-1}" --launch-count 1 \
     -f -o "$out/$name" "$@" > "$out/$name.log" 2>&1
   echo "profile rc=$?"
   ncu -i "$out/$name.ncu-rep" --page source --csv --print-source sass > "$out/$name-sass.csv" 2> "$out/$name-sass.err"
@@ -31,4 +34,4 @@ profile() {  # name, kernel regex, then the command
 profile pixel k_pixel "$build/bin/pathbench" render --device gpu --quiet --scene paper-cornell --width 256 --height 256 \
   --spp "$spp" --bounces 2 --sampling nee --strategy pixel
 profile raycast k_trace "$build/bin/pathbench-bench" --preset paper \
-  --benchmark_filter='^raycast/gpu/closest/incoherent/paper-cornell$' --benchmark_min_time=0.01s
+  --benchmark_filter='^raycast/gpu/closest/incoherent/paper-cornell$'
