@@ -16,12 +16,12 @@ b=${2:?usage: scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
 out=${3:?usage: scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
 rounds=${4:-5}
 mkdir -p "$out/films"
-paper="--scene paper-cornell --width 256 --height 256 --spp 800 --bounces 2"
-default_cases="paper-pixel-nee | $paper --sampling nee --strategy pixel
-paper-wavefront-nee | $paper --sampling nee --strategy wavefront
-paper-queue-nee | $paper --sampling nee --strategy paper-queue
-paper-pixel-uniform | $paper --sampling uniform --strategy pixel
-ico8-pixel-nee | --scene paper-cornell-ico:8 --width 256 --height 256 --spp 800 --bounces 2 --sampling nee --strategy pixel"
+frame="--width 256 --height 256 --spp 800 --bounces 2"
+default_cases="paper-pixel-nee | --scene paper-cornell $frame --sampling nee --strategy pixel
+paper-wavefront-nee | --scene paper-cornell $frame --sampling nee --strategy wavefront
+paper-queue-nee | --scene paper-cornell $frame --sampling nee --strategy paper-queue
+paper-pixel-uniform | --scene paper-cornell $frame --sampling uniform --strategy pixel
+ico8-pixel-nee | --scene paper-cornell-ico:8 $frame --sampling nee --strategy pixel"
 cases=$(if [ -n "${CASES:-}" ]; then cat "$CASES"; else echo "$default_cases"; fi)
 tsv="$out/ab.tsv"
 echo -e "round\tcase\tbuild\tdevice_ms\tfilm_sha" > "$tsv"

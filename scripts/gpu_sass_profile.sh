@@ -4,7 +4,9 @@
 # sampled warp stalls per SASS address) for the pixel megakernel on paper-cornell and the
 # raw incoherent closest-hit ray casts on the same scene. Runs on the GPU host, after
 # gpu/run_on_device.sh's build (BUILD_DIR/bin/pathbench, pathbench-bench);
-# tools/sass_profile.py turns the CSVs into a table per source line and per SASS opcode.
+# tools/sass_profile.py turns the SASS CSV into tables by opcode and by hot block. (The
+# source page's CUDA view is not exported: with -lineinfo it gave only the kernel's own file,
+# without counts.)
 #   scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR
 # --clock-control none as in scripts/gpu_roofline.sh. One launch per kernel, after the first
 # (a render's first launch is its warm-up frame, one sample a pixel, whose warps span 32
@@ -26,8 +28,6 @@ profile() {  # name, kernel regex, then the command
   echo "profile rc=$?"
   ncu -i "$out/$name.ncu-rep" --page source --csv --print-source sass > "$out/$name-sass.csv" 2> "$out/$name-sass.err"
   echo "sass page rc=$? $(wc -l < "$out/$name-sass.csv") lines"
-  ncu -i "$out/$name.ncu-rep" --page source --csv --print-source cuda > "$out/$name-cuda.csv" 2> "$out/$name-cuda.err"
-  echo "cuda page rc=$? $(wc -l < "$out/$name-cuda.csv") lines"
   ncu -i "$out/$name.ncu-rep" --page details --csv > "$out/$name-details.csv" 2> "$out/$name-details.err"
   echo "details rc=$? $(wc -l < "$out/$name-details.csv") lines"
 }

@@ -14,10 +14,10 @@ import argparse
 import collections
 import csv
 import gzip
-import io
 import re
 import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 STALL_COLUMN = "Warp Stall Sampling (All Samples)"
 
@@ -47,11 +47,17 @@ class Block:
 
 
 def read_instructions(path):
-    """The SASS instructions of the CSV, in address order. Raises ValueError when the file
+    """The SASS instructions of the CSV, in address order. Raises ValueError when the path
+    is not a regular file (a device or FIFO would be read forever or wait for a writer) or
     has no 'Source' and 'Instructions Executed' header row (not a source page)."""
-    raw = gzip.open(path, "rt") if str(path).endswith(".gz") else open(path, newline="")
-    with raw:
-        rows = list(csv.reader(io.StringIO(raw.read())))
+    if not Path(path).is_file():
+        raise ValueError(f"{path}: not a regular file")
+    opener = gzip.open if str(path).endswith(".gz") else open
+    try:
+        with opener(path, "rt", newline="") as raw:
+            rows = list(csv.reader(raw))
+    except (csv.Error, UnicodeDecodeError, gzip.BadGzipFile) as e:
+        raise ValueError(f"{path}: not a CSV file ({e})") from e
     for i, r in enumerate(rows):
         if "Instructions Executed" in r and "Source" in r:
             hdr, body = r, rows[i + 1:]
@@ -65,8 +71,11 @@ def read_instructions(path):
     for r in body:
         if len(r) <= max(src, ex):
             continue
-        stalls = float(r[st] or 0) if st is not None and len(r) > st else 0.0
-        out.append(Instruction(r[src].strip(), float(r[ex] or 0), stalls))
+        try:
+            stalls = float(r[st] or 0) if st is not None and len(r) > st else 0.0
+            out.append(Instruction(r[src].strip(), float(r[ex] or 0), stalls))
+        except ValueError as e:
+            raise ValueError(f"{path}: a count that is not a number ({e})") from e
     return out
 
 
@@ -120,8 +129,10 @@ def main(argv=None):
     ap.add_argument("--per", type=float, default=1.0, help="divide counts by this (units of work in the launch)")
     ap.add_argument("--top", type=int, default=25)
     a = ap.parse_args(argv)
-    if a.per <= 0:
+    if not a.per > 0:
         ap.error("--per must be positive")
+    if a.top < 1:
+        ap.error("--top must be at least 1")
     try:
         print(report(read_instructions(a.csv), a.per, a.top))
     except (OSError, ValueError) as e:

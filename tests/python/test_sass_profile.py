@@ -1,6 +1,6 @@
 """tools/sass_profile.py on a small CSV of the form ncu's SASS source page takes (a kernel
 row, a header row, one row per SASS instruction), and on the committed profile."""
-import gzip
+import os
 from pathlib import Path
 
 import pytest
@@ -69,6 +69,25 @@ def test_refuses_what_is_not_a_source_page(tmp_path, capsys):
     assert sass_profile.main([str(p)]) == 2
     assert "not the CSV of ncu --page source" in capsys.readouterr().err
     assert sass_profile.main([str(tmp_path / "missing.csv")]) == 2
+    bad = tmp_path / "bad.csv"
+    bad.write_text(",".join(HEADER) + '\n"0x0","NOP","x","1","32"\n')
+    assert sass_profile.main([str(bad)]) == 2
+    assert "not a number" in capsys.readouterr().err
+
+
+def test_refuses_special_files_without_reading_them(tmp_path, capsys):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)  # no writer: opening it would wait for ever
+    for p in (fifo, Path("/dev/zero"), tmp_path):
+        assert sass_profile.main([str(p)]) == 2
+        assert "not a regular file" in capsys.readouterr().err
+
+
+def test_refuses_bad_options(profile):
+    for args in (["--per", "0"], ["--per", "nan"], ["--top", "0"]):
+        with pytest.raises(SystemExit) as e:
+            sass_profile.main([str(profile), *args])
+        assert e.value.code == 2
 
 
 def test_gzipped_profile_of_record():
