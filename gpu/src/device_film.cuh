@@ -45,6 +45,10 @@ __device__ __forceinline__ unsigned long long warp_sum_u64(unsigned long long v)
 // pixel and channel. Strategies that hand out consecutive samples of a pixel to
 // neighbouring lanes thus need ~1/32 of the atomics, and no lane of a warp waits on
 // 32 same-address atomics.
+// A lane that adds nothing takes this key: no pixel has it (pixels < 2^31,
+// RenderSettings::validate), so its run never reaches the film.
+constexpr uint32_t kNoPixel = 0xFFFFFFFFu;
+
 template <bool kVariance>
 __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uint32_t pixel, const Vec3f& L,
                                               unsigned long long* discarded) {
@@ -55,7 +59,7 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
   const uint32_t lane = threadIdx.x & 31;
   const bool ok = add && sample_acceptable(L, film.limit);
   if (add && !ok) atomicAdd(discarded, 1ull);
-  const uint32_t key = ok ? pixel : 0xFFFFFFFFu;
+  const uint32_t key = ok ? pixel : kNoPixel;
   long long q0 = ok ? quantize_radiance(L.x, film.scale) : 0;
   long long q1 = ok ? quantize_radiance(L.y, film.scale) : 0;
   long long q2 = ok ? quantize_radiance(L.z, film.scale) : 0;
@@ -68,7 +72,7 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
   }
   const uint32_t key_prev = __shfl_up_sync(kFullMask, key, 1);
   const uint32_t heads = __ballot_sync(kFullMask, lane == 0 || key_prev != key);
-  if (!kVariance && heads == 1u && key != 0xFFFFFFFFu) {
+  if (!kVariance && heads == 1u && key != kNoPixel) {
     // The whole warp is one run of one pixel, every sample accepted (the pixel strategy
     // whenever spp is a multiple of 32, as the paper's 800): the warp's reduction unit sums
     // each channel. It adds 32-bit words, so each 64-bit value goes in as three pieces of
@@ -111,7 +115,7 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
       if (kVariance) { s0 += b0; s1 += b1; s2 += b2; }
     }
   }
-  if (key != 0xFFFFFFFFu && run == lane) {
+  if (key != kNoPixel && run == lane) {
     unsigned long long* sum = film.sum + size_t(key) * 3;
     atomicAdd(sum + 0, static_cast<unsigned long long>(q0));
     atomicAdd(sum + 1, static_cast<unsigned long long>(q1));

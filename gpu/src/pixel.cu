@@ -1,7 +1,6 @@
-// The pixel strategy: one megakernel, one thread per pixel sample (grid-stride over all
-// samples of the frame, a warp taking 32 consecutive samples), the whole path in
-// registers. Samples of one pixel are summed in the warp (exact integer sums) before one
-// atomic per pixel.
+// The pixel strategy: one megakernel, one thread per pixel sample (a warp takes chunks of
+// 32 consecutive samples from a counter), the whole path in registers. Samples of one
+// pixel are summed in the warp (exact integer sums) before one atomic per pixel.
 #include <cuda_runtime.h>
 #include <fmt/core.h>
 
@@ -15,6 +14,7 @@
 #include "pathbench/gpu/traversal.h"
 #include "pathbench/common/errors.h"
 #include "strategies.cuh"
+#include "work_chunks.cuh"
 
 namespace pb::gpu {
 
@@ -50,24 +50,23 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
 // (latency bound).
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks>
 __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
-                                               FilmDev film, Stats* stats) {
+                                               FilmDev film, PixelCounters* ctr) {
   kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
-  const uint64_t warp = (uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
-  const uint64_t warps = (uint64_t(gridDim.x) * blockDim.x) >> 5;
   uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0;
-  for (uint64_t base = warp * 32; base < total; base += warps * 32) {
-    const uint64_t g = base + lane;
+  // Every chunk of 32 samples from the counter (work_chunks.cuh).
+  for_each_chunk<unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, [&](unsigned long long k) {
+    const uint64_t g = k * 32 + lane;
     const bool valid = g < total;
-    const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / spp) : 0xFFFFFFFFu;
+    const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / spp) : kNoPixel;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
       L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
       ++n_paths;
     }
-    film_add_warp<kVariance>(film, valid, pixel, L, &stats->discarded);
-  }
-  block_stats_add(stats, n_bounce, n_shadow, n_paths);
+    film_add_warp<kVariance>(film, valid, pixel, L, &ctr->stats.discarded);
+  });
+  block_stats_add(&ctr->stats, n_bounce, n_shadow, n_paths);
 }
 
 }  // namespace
@@ -88,15 +87,15 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
 
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<Stats>& stats, int min_blocks) {
-  PB_CUDA_CHECK(cudaMemsetAsync(stats.get(), 0, sizeof(Stats), stream));
+                      DeviceBuffer<PixelCounters>& counters, int min_blocks) {
+  PB_CUDA_CHECK(cudaMemsetAsync(counters.get(), 0, sizeof(PixelCounters), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
   // In float with the watertight test, compiled for the scene's BVH layout and the
   // occupancy that suits its size; or (the accuracy study's variants) in double or with
   // Moeller-Trumbore, switching on it at the compiler's occupancy.
   with_features(g.view.material_kinds, [&](auto kinds) {
     constexpr uint32_t K = decltype(kinds)::value;
-    auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, stats.get()); };
+    auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, counters.get()); };
     constexpr int kAny = kAnyKind;
     if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny, 1>) : go(k_pixel<false, K, double, true, kAny, 1>);
     else if (!watertight) variance ? go(k_pixel<true, K, float, false, kAny, 1>) : go(k_pixel<false, K, float, false, kAny, 1>);
@@ -109,7 +108,7 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
       });
   });
   FrameResult r;
-  PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, stats.get(), sizeof(Stats), cudaMemcpyDeviceToHost, stream));
+  PB_CUDA_CHECK(cudaMemcpyAsync(&r.stats, &counters.get()->stats, sizeof(Stats), cudaMemcpyDeviceToHost, stream));
   PB_CUDA_CHECK(cudaStreamSynchronize(stream));
   r.state_bytes_per_path = 0;  // in registers
   return r;

@@ -123,10 +123,10 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
 
   // Strategy resources.
   std::unique_ptr<PathPool> pool;
-  DeviceBuffer<Stats> pixel_stats;
+  DeviceBuffer<PixelCounters> pixel_counters;
   uint64_t warmup_total = std::min<uint64_t>(total, pixels);
   if (settings.strategy == Strategy::Pixel) {
-    pixel_stats.allocate(1, "counters", "nothing (8 bytes)");
+    pixel_counters.allocate(1, "counters", "nothing (a few bytes)");
   } else if (settings.strategy == Strategy::Wavefront) {
     uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight();
     pif = std::min<uint64_t>(pif, total);
@@ -153,7 +153,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   auto run_frame = [&](uint64_t n) {
     if (settings.strategy == Strategy::Pixel)
       return run_pixel(launch, stream.s, g, config, spp, n, fb.view, film.has_variance(), settings.precision,
-                       settings.watertight, pixel_stats, occupancy.min_blocks);
+                       settings.watertight, pixel_counters, occupancy.min_blocks);
     return pool->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
   };
 

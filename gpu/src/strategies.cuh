@@ -51,11 +51,18 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 constexpr int kPixelLatencyBlocks = 8;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
+// The pixel megakernel's counters on the device, zeroed before each frame: the stats,
+// and the next chunk of 32 samples to hand out (k_pixel takes its work from it).
+struct PixelCounters {
+  Stats stats;
+  unsigned long long chunks;
+};
+
 // The pixel megakernel over `total` samples (spp per pixel), compiled for the scene's
-// material kinds; `stats` is its counter block on the device; `min_blocks` from
+// material kinds; `counters` is its counter block on the device; `min_blocks` from
 // pixel_occupancy (float and watertight only: the accuracy variants keep the compiler's).
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<Stats>& stats, int min_blocks);
+                      DeviceBuffer<PixelCounters>& counters, int min_blocks);
 
 }  // namespace pb::gpu

@@ -12,6 +12,7 @@
 #include "path_step.cuh"
 #include "pathbench/gpu/traversal.h"
 #include "wavefront_state.cuh"
+#include "work_chunks.cuh"
 
 namespace pb::gpu {
 namespace {
@@ -79,45 +80,63 @@ __device__ __forceinline__ PathState<float> current_path(const SceneView& s, con
 template <int kKind>
 constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
 
-// The shadow rays the last shade queued (n of them): occlusion, then the radiance to the
-// film (a path that ended) or to the continuing path's L in `continued`, the buffer the
-// last shade wrote and the next one reads.
+// One chunk of the shadow rays the last shade queued (n of them; rays [base, base + 32)):
+// occlusion, then the radiance to the film (a path that ended) or to the continuing path's
+// L in `continued`, the buffer the last shade wrote and the next one reads. All 32 lanes
+// call it (film_add_warp).
 template <bool kVariance, int kKind>
-__device__ __forceinline__ void trace_shadow_rays(const BvhView& bvh, const ShadowSoA& sh, const PathSoA& continued,
-                                                  uint32_t n, const FilmDev& film, unsigned long long* discarded) {
-  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
-  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
-    const uint32_t i = base + lane;
-    bool add = false;
-    uint32_t pixel = 0;
-    Vec3f L{0.0f, 0.0f, 0.0f};
-    if (i < n) {
-      const float4 o = sh.o[i], d = sh.d[i];
-      const float2 ct = sh.ct[i];
-      const uint32_t target = __float_as_uint(ct.y);
-      const Vec3f origin{o.x, o.y, o.z};
-      const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
-      if (target & kShadowDone) {
-        const float4 l = sh.L[i];
-        L = {l.x, l.y, l.z};
-        if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
-        if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
-          const float4 d2 = sh.d2[i];
-          const float2 c2 = sh.c2[i];
-          if (!occluded<true, kKind>(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
-        }
-        add = true;
-        pixel = target & ~kShadowDone;
-      } else if (visible) {
-        float4 Lt = continued.L[target];
-        Lt.x = Lt.x + o.w;
-        Lt.y = Lt.y + d.w;
-        Lt.z = Lt.z + ct.x;
-        continued.L[target] = Lt;
+__device__ __forceinline__ void trace_shadow_chunk(const BvhView& bvh, const ShadowSoA& sh, const PathSoA& continued,
+                                                   uint32_t base, uint32_t n, const FilmDev& film,
+                                                   unsigned long long* discarded) {
+  const uint32_t i = base + (threadIdx.x & 31);
+  bool add = false;
+  uint32_t pixel = 0;
+  Vec3f L{0.0f, 0.0f, 0.0f};
+  if (i < n) {
+    const float4 o = sh.o[i], d = sh.d[i];
+    const float2 ct = sh.ct[i];
+    const uint32_t target = __float_as_uint(ct.y);
+    const Vec3f origin{o.x, o.y, o.z};
+    const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
+    if (target & kShadowDone) {
+      const float4 l = sh.L[i];
+      L = {l.x, l.y, l.z};
+      if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
+      if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
+        const float4 d2 = sh.d2[i];
+        const float2 c2 = sh.c2[i];
+        if (!occluded<true, kKind>(bvh, origin, {d2.x, d2.y, d2.z}, 1.0f)) L = L + Vec3f{d2.w, c2.x, c2.y};
       }
+      add = true;
+      pixel = target & ~kShadowDone;
+    } else if (visible) {
+      float4 Lt = continued.L[target];
+      Lt.x = Lt.x + o.w;
+      Lt.y = Lt.y + d.w;
+      Lt.z = Lt.z + ct.x;
+      continued.L[target] = Lt;
     }
-    film_add_warp<kVariance>(film, add, pixel, L, discarded);
   }
+  film_add_warp<kVariance>(film, add, pixel, L, discarded);
+}
+
+// Path i's closest hit: its ray from `cur` (a continuing path) or made from its sample
+// index (a new one).
+template <int kKind>
+__device__ __forceinline__ void trace_closest(const SceneView& s, const PathConfig& c, const BvhView& bvh,
+                                              const PathSoA& cur, const NewPaths& fresh, uint32_t* prim, uint32_t i) {
+  Vec3f o, d;
+  if (i < fresh.dst) {
+    const float4 o4 = cur.o[i], d4 = cur.d[i];
+    o = {o4.x, o4.y, o4.z};
+    d = {d4.x, d4.y, d4.z};
+  } else {
+    const PathState<float> st = current_path(s, c, cur, fresh, i);
+    o = st.ray.o;
+    d = st.ray.d;
+  }
+  float t;
+  prim[i] = intersect_closest<true, kKind>(bvh, o, d, kInf, t);
 }
 
 // One launch for both traversal stages: the shadow rays the iteration before queued
@@ -135,32 +154,89 @@ __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>)
   const uint32_t n_shadow = prev.n_shadow;  // thread 0 below writes it[parity], not prev
   if (grid_thread() == 0) {
     record_plan(ctr, step.parity, plan);
+    ctr->chunks.shade = 0;  // shade's counter: the last shade is done, the next starts after this trace
     *reinterpret_cast<volatile uint32_t*>(step.planned) = plan.n_cur != 0;  // for the host's loop
     __threadfence_system();
   }
-  if constexpr (kShadows) trace_shadow_rays<kVariance, kKind>(bvh, sh, cur, n_shadow, film, &ctr->stats.discarded);
   const uint32_t n = plan.n_cur;
   const NewPaths fresh{plan.gen_dst, plan.gen_base, spp};
-  for (uint32_t i = grid_thread(); i < n; i += grid_threads()) {
-    Vec3f o, d;
-    if (i < fresh.dst) {
-      const float4 o4 = cur.o[i], d4 = cur.d[i];
-      o = {o4.x, o4.y, o4.z};
-      d = {d4.x, d4.y, d4.z};
-    } else {
-      const PathState<float> st = current_path(s, c, cur, fresh, i);
-      o = st.ray.o;
-      d = st.ray.d;
-    }
-    float t;
-    prim[i] = intersect_closest<true, kKind>(bvh, o, d, kInf, t);
+  unsigned long long* discarded = &ctr->stats.discarded;
+  // The shadow rays first, then the closest hits, each in chunks (for_each_chunk).
+  if constexpr (kShadows) {
+    const uint32_t end = (n_shadow + 31) / 32;
+    for_each_chunk(end, static_chunks(end), &ctr->chunks.shadow, [&](uint32_t k) {
+      trace_shadow_chunk<kVariance, kKind>(bvh, sh, cur, k * 32, n_shadow, film, discarded);
+    });
   }
+  const uint32_t end = (n + 31) / 32;
+  for_each_chunk(end, static_chunks(end), &ctr->chunks.closest, [&](uint32_t k) {
+    const uint32_t i = k * 32 + (threadIdx.x & 31);
+    if (i < n) trace_closest<kKind>(s, c, bvh, cur, fresh, prim, i);
+  });
 }
 
 __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, const ShadowQuery<float>& q, uint32_t target) {
   sh.o[k] = make_float4(q.ray.o.x, q.ray.o.y, q.ray.o.z, q.contribution.x);
   sh.d[k] = make_float4(q.ray.d.x, q.ray.d.y, q.ray.d.z, q.contribution.y);
   sh.ct[k] = make_float2(q.contribution.z, __uint_as_float(target));
+}
+
+// One chunk of shade: paths [base, base + 32) of `cur` (n of them). All 32 lanes call it
+// (film_add_warp, the pair count).
+template <bool kVariance, uint32_t Kinds>
+__device__ __forceinline__ void shade_chunk(const SceneView& s, const PathConfig& c, const PathSoA& cur,
+                                            const PathSoA& next, const uint32_t* prim, const ShadowSoA& sh,
+                                            WaveCounters* ctr, IterationCounters& at, const NewPaths& fresh,
+                                            const FilmDev& film, uint32_t base, uint32_t n) {
+  const uint32_t lane = threadIdx.x & 31;
+  const uint32_t i = base + lane;
+  bool add = false, pair = false;
+  uint32_t pixel = 0;
+  Vec3f L_add{0.0f, 0.0f, 0.0f};
+  if (i < n) {
+    PathState<float> st = current_path(s, c, cur, fresh, i);
+    const uint32_t h = prim[i];
+    pixel = st.pixel;
+    if (h == kNoHit) {
+      add = true;
+      L_add = st.L;
+    } else {
+      ShadowQuery<float> q, fq;
+      bool wants_shadow;
+      PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
+      // The next vertex would be the last: answer it here (trace_path does the same
+      // at the top of its loop), so the path never goes through trace + shade again.
+      bool final_ray = false;
+      if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
+        final_ray = path_final_query<Kinds>(s, c, st, fq);
+        ev = PathEvent::Done;
+      }
+      uint32_t target = kShadowDone | st.pixel;
+      if (ev == PathEvent::Continue) {
+        const uint32_t j = queue_push(&at.n_next);
+        store_path(next, j, st);
+        target = j;
+      }
+      if (wants_shadow || final_ray) {
+        // Light-sampling ray first (shadow_unoccluded's order in trace_path); both
+        // rays of a pair leave from the same origin (the offset hit point).
+        const uint32_t k = queue_push(&at.n_shadow);
+        push_shadow(sh, k, wants_shadow ? q : fq, target);
+        pair = wants_shadow && final_ray;
+        if (pair) {
+          sh.d2[k] = make_float4(fq.ray.d.x, fq.ray.d.y, fq.ray.d.z, fq.contribution.x);
+          sh.c2[k] = make_float2(fq.contribution.y, fq.contribution.z);
+        }
+        if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, pair ? 1.0f : 0.0f);
+      } else if (ev == PathEvent::Done) {
+        add = true;
+        L_add = st.L;
+      }
+    }
+  }
+  film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
+  const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
+  if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
 }
 
 template <bool kVariance, uint32_t Kinds>
@@ -171,57 +247,14 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
   IterationCounters& at = ctr->it[parity];
   const uint32_t n = at.n_cur;
   const NewPaths fresh{at.gen_dst, at.gen_base, spp};
-  const uint32_t lane = threadIdx.x & 31, warp = grid_thread() >> 5, warps = grid_threads() >> 5;
-  for (uint32_t base = warp * 32; base < n; base += warps * 32) {  // warp-uniform: film_add_warp
-    const uint32_t i = base + lane;
-    bool add = false, pair = false;
-    uint32_t pixel = 0;
-    Vec3f L_add{0.0f, 0.0f, 0.0f};
-    if (i < n) {
-      PathState<float> st = current_path(s, c, cur, fresh, i);
-      const uint32_t h = prim[i];
-      pixel = st.pixel;
-      if (h == kNoHit) {
-        add = true;
-        L_add = st.L;
-      } else {
-        ShadowQuery<float> q, fq;
-        bool wants_shadow;
-        PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
-        // The next vertex would be the last: answer it here (trace_path does the same
-        // at the top of its loop), so the path never goes through trace + shade again.
-        bool final_ray = false;
-        if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
-          final_ray = path_final_query<Kinds>(s, c, st, fq);
-          ev = PathEvent::Done;
-        }
-        uint32_t target = kShadowDone | st.pixel;
-        if (ev == PathEvent::Continue) {
-          const uint32_t j = queue_push(&at.n_next);
-          store_path(next, j, st);
-          target = j;
-        }
-        if (wants_shadow || final_ray) {
-          // Light-sampling ray first (shadow_unoccluded's order in trace_path); both
-          // rays of a pair leave from the same origin (the offset hit point).
-          const uint32_t k = queue_push(&at.n_shadow);
-          push_shadow(sh, k, wants_shadow ? q : fq, target);
-          pair = wants_shadow && final_ray;
-          if (pair) {
-            sh.d2[k] = make_float4(fq.ray.d.x, fq.ray.d.y, fq.ray.d.z, fq.contribution.x);
-            sh.c2[k] = make_float2(fq.contribution.y, fq.contribution.z);
-          }
-          if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, pair ? 1.0f : 0.0f);
-        } else if (ev == PathEvent::Done) {
-          add = true;
-          L_add = st.L;
-        }
-      }
-    }
-    film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
-    const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
-    if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
+  if (grid_thread() == 0) {  // the next trace's counters: this iteration's trace is done
+    ctr->chunks.shadow = 0;
+    ctr->chunks.closest = 0;
   }
+  const uint32_t end = (n + 31) / 32;
+  for_each_chunk(end, static_chunks(end), &ctr->chunks.shade, [&](uint32_t k) {
+    shade_chunk<kVariance, Kinds>(s, c, cur, next, prim, sh, ctr, at, fresh, film, k * 32, n);
+  });
 }
 
 }  // namespace

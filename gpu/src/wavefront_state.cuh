@@ -54,9 +54,19 @@ struct IterationCounters {
 
 constexpr uint32_t kNotPlanned = 0xFFFFFFFFu;  // a plan slot the GPU has not written yet (PathPool)
 
+// Chunk counters of the stage kernels (work_chunks.cuh): trace's are reset by shade
+// and shade's by trace, each by a kernel that runs wholly between the two launches that use
+// it (stream order and PDL's wait in kernel_prologue), so no launch of their own is needed.
+struct ChunkCounters {
+  uint32_t shadow;   // trace: the shadow rays
+  uint32_t closest;  // trace: the closest hits
+  uint32_t shade;
+};
+
 struct WaveCounters {
   IterationCounters it[2];
   Stats stats;  // booked by the planning thread, plus the kernels' atomics
+  ChunkCounters chunks;
 };
 
 // Warp-aggregated append: one atomic per warp.

@@ -1,0 +1,45 @@
+#pragma once
+// Work handed out to warps in chunks of 32 consecutive items (chunk k: items [32 k, 32 k +
+// 32)), used by the persistent kernels (the pixel megakernel, the wavefront's stages). The
+// first `fixed` chunks go by grid stride (warp w takes w, w + W, ...: no atomics); the rest
+// come from a counter, one atomic a chunk, so a warp that drew short work takes more and a
+// launch ends when its work does, not with the warp of the longest static share.
+// Measured on an H100 (gpu/NOTES.md, "Work from a counter"): the megakernel all from the
+// counter, paper-cornell 12.00 -> 11.58 ms, ico:8 48.6 -> 43.0; the wavefront's stages
+// with only the last full round and the partial one from it, ico:8 -6 % (more rounds from
+// the counter: ico:8 faster still, paper-cornell slower).
+#include <cuda_runtime.h>
+
+#include <cstdint>
+
+#include "kernel_sync.h"
+
+namespace pb::gpu {
+
+// body(k) for chunks k < end; `counter` (zero on entry) hands out the chunks from `fixed`
+// on. All 32 lanes of a warp call it and body(k) (k is warp-uniform). Index: uint32_t or
+// unsigned long long (atomicAdd's types).
+template <class Index, class Body>
+__device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* counter, Body&& body) {
+  const Index warp = grid_thread() >> 5, warps = grid_threads() >> 5;
+  const bool leader = (threadIdx.x & 31) == 0;
+  Index claim = warp < fixed || !leader ? Index(0) : atomicAdd(counter, Index(1));
+  Index k = warp < fixed ? warp : fixed + __shfl_sync(0xFFFFFFFFu, claim, 0);
+  while (k < end) {  // one call site of body: inlined once
+    // The next chunk is the static one after k, or a claim made now, before working on k,
+    // so that the atomic's latency hides behind the work.
+    const bool claims = k + warps >= fixed;
+    if (claims && leader) claim = atomicAdd(counter, Index(1));
+    body(k);
+    k = claims ? fixed + __shfl_sync(0xFFFFFFFFu, claim, 0) : k + warps;
+  }
+}
+
+// The wavefront's split: every full round of the grid stride but the last static, the last
+// full round and the partial one from the counter.
+__device__ __forceinline__ uint32_t static_chunks(uint32_t end) {
+  const uint32_t warps = grid_threads() >> 5, rounds = end / warps;
+  return rounds > 1 ? (rounds - 1) * warps : 0;
+}
+
+}  // namespace pb::gpu
