@@ -47,10 +47,12 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   constexpr uint64_t kLag = 3;
   static_assert(kLag < kPlanSlots, "a slot is read and reset before the GPU reaches it again");
   for (int k = 0; k < kPlanSlots; ++k) planned_[k] = kNotPlanned;
+  const uint32_t counter_rounds =
+      g.bvh_tris >= kPixelLatencyBoundTris ? kWavefrontCounterRoundsLatencyBound : kWavefrontCounterRounds;
   for (uint64_t it = 0;; ++it) {
     const PathSoA cur = buf_[it & 1].view(), next = buf_[(it + 1) & 1].view();
     const uint32_t parity = uint32_t(it & 1);
-    const WaveStep step{parity, static_cast<unsigned long long>(total), cap, &planned_[it % kPlanSlots]};
+    const WaveStep step{parity, static_cast<unsigned long long>(total), cap, &planned_[it % kPlanSlots], counter_rounds};
     with_traversal_kind(g.bvh, [&](auto kind) {  // trace compiled for the BVH layout
       constexpr int B = decltype(kind)::value;
       auto go = [&](auto kernel) {
@@ -63,8 +65,8 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
     });
     with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
       constexpr uint32_t K = decltype(kinds)::value;
-      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
-      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp);
+      if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp, counter_rounds);
+      else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp, counter_rounds);
     });
     if (it >= kLag) {
       const uint64_t seen = it - kLag;
@@ -84,6 +86,7 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   r.stats.paths = r.stats.camera;
   r.state_bytes_per_path = state_bytes(shadows_);
   r.paths_in_flight = capacity_;
+  r.counter_rounds = counter_rounds;
   r.pool_bytes = capacity_ * state_bytes(shadows_) + sizeof(WaveCounters);
   return r;
 }

@@ -235,6 +235,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
                         (shadows.pairs ? " + a pair's second ray (d: float4; c.yz: float2)" : "");
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
+    x["counter_rounds"] = r.counter_rounds;  // work_chunks.cuh: the stages' last rounds from a counter
   }
   if (settings.strategy == Strategy::PaperQueue) {
     x["bytes_per_task"] = r.state_bytes_per_path;  // the queues are the compacted state buffers themselves

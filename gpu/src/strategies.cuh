@@ -20,6 +20,7 @@ struct FrameResult {
   Stats stats{};
   uint64_t state_bytes_per_path = 0, paths_in_flight = 0, pool_bytes = 0;
   uint64_t iterations = 0;
+  uint32_t counter_rounds = 0;  // wavefront, paper-queue: kWavefrontCounterRounds or ...LatencyBound
 };
 
 // Which shadow records a frame needs: light-sampling rays, the last vertex's emitter
@@ -50,6 +51,13 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/pixel-occupancy-8).
 constexpr int kPixelLatencyBlocks = 8;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
+
+// How many of the last full rounds of a wavefront stage's grid stride its warps take from
+// a counter (work_chunks.cuh): more where traversals diverge (from kPixelLatencyBoundTris
+// triangle references on), where static shares end most unevenly. H100, interleaved
+// (results/nvidia-h100-80gb-hbm3/work-chunks): paper-cornell 1 round 15.63 ms, 4 rounds
+// 16.15; ico:8 (100 spp) 1 round 8.30, 4 rounds 7.70 (grid stride alone: 8.87).
+constexpr uint32_t kWavefrontCounterRounds = 1, kWavefrontCounterRoundsLatencyBound = 4;
 
 // The pixel megakernel's counters on the device, zeroed before each frame: the stats,
 // and the next chunk of 32 samples to hand out (k_pixel takes its work from it).

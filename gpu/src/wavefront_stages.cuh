@@ -52,6 +52,7 @@ struct WaveStep {
   unsigned long long total;  // samples in the frame
   uint32_t capacity;         // paths a buffer holds
   uint32_t* planned;         // mapped host memory: 1 if this iteration has paths to trace, else 0
+  uint32_t counter_rounds;   // work_chunks.cuh's static_chunks (kWavefrontCounterRounds)
 };
 
 // This iteration's new samples: indices [gen_dst, n_cur) of the current buffer, after
@@ -164,12 +165,12 @@ __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>)
   // The shadow rays first, then the closest hits, each in chunks (for_each_chunk).
   if constexpr (kShadows) {
     const uint32_t end = (n_shadow + 31) / 32;
-    for_each_chunk(end, static_chunks(end), &ctr->chunks.shadow, [&](uint32_t k) {
+    for_each_chunk(end, static_chunks(end, step.counter_rounds), &ctr->chunks.shadow, [&](uint32_t k) {
       trace_shadow_chunk<kVariance, kKind>(bvh, sh, cur, k * 32, n_shadow, film, discarded);
     });
   }
   const uint32_t end = (n + 31) / 32;
-  for_each_chunk(end, static_chunks(end), &ctr->chunks.closest, [&](uint32_t k) {
+  for_each_chunk(end, static_chunks(end, step.counter_rounds), &ctr->chunks.closest, [&](uint32_t k) {
     const uint32_t i = k * 32 + (threadIdx.x & 31);
     if (i < n) trace_closest<kKind>(s, c, bvh, cur, fresh, prim, i);
   });
@@ -242,7 +243,7 @@ __device__ __forceinline__ void shade_chunk(const SceneView& s, const PathConfig
 template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, uint32_t parity,
-                                                     FilmDev film, uint32_t spp) {
+                                                     FilmDev film, uint32_t spp, uint32_t counter_rounds) {
   kernel_prologue();
   IterationCounters& at = ctr->it[parity];
   const uint32_t n = at.n_cur;
@@ -252,7 +253,7 @@ __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, 
     ctr->chunks.closest = 0;
   }
   const uint32_t end = (n + 31) / 32;
-  for_each_chunk(end, static_chunks(end), &ctr->chunks.shade, [&](uint32_t k) {
+  for_each_chunk(end, static_chunks(end, counter_rounds), &ctr->chunks.shade, [&](uint32_t k) {
     shade_chunk<kVariance, Kinds>(s, c, cur, next, prim, sh, ctr, at, fresh, film, k * 32, n);
   });
 }

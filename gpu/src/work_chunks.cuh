@@ -6,8 +6,8 @@
 // launch ends when its work does, not with the warp of the longest static share.
 // Measured on an H100 (gpu/NOTES.md, "Work from a counter"): the megakernel all from the
 // counter, paper-cornell 12.00 -> 11.58 ms, ico:8 48.6 -> 43.0; the wavefront's stages
-// with only the last full round and the partial one from it, ico:8 -6 % (more rounds from
-// the counter: ico:8 faster still, paper-cornell slower).
+// with the last full round and the partial one from it, paper-cornell unchanged, ico:8 -6 %;
+// with the last 4, ico:8 -14 %, paper-cornell +3.5 % (strategies.cuh, kWavefrontCounterRounds).
 #include <cuda_runtime.h>
 
 #include <cstdint>
@@ -35,11 +35,11 @@ __device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* co
   }
 }
 
-// The wavefront's split: every full round of the grid stride but the last static, the last
-// full round and the partial one from the counter.
-__device__ __forceinline__ uint32_t static_chunks(uint32_t end) {
+// The wavefront's split: every full round of the grid stride static but the last
+// `counter_rounds`; those and the partial round from the counter.
+__device__ __forceinline__ uint32_t static_chunks(uint32_t end, uint32_t counter_rounds) {
   const uint32_t warps = grid_threads() >> 5, rounds = end / warps;
-  return rounds > 1 ? (rounds - 1) * warps : 0;
+  return rounds > counter_rounds ? (rounds - counter_rounds) * warps : 0;
 }
 
 }  // namespace pb::gpu
