@@ -149,6 +149,15 @@ class Launcher {
       st.events.push_back({ev[0], ev[1]});
     }
   }
+  // A persistent kernel (it loops over its work): one full wave, or fewer blocks where
+  // `threads`, the most its work can keep busy, is less (idle warps would still run its
+  // prologue, and claim work from a counter: work_chunks.cuh).
+  template <class... KArgs, class... Args>
+  void launch_persistent(const char* name, void (*kernel)(KArgs...), uint64_t threads, Args&&... args) {
+    const Stage& st = stage(name, reinterpret_cast<const void*>(kernel));
+    const uint64_t wave = uint64_t(st.full_wave_blocks) * uint64_t(st.block);
+    launch(name, kernel, threads < wave ? threads : 0, std::forward<Args>(args)...);
+  }
   int block_size(const char* name) const;
   // After the stream is synchronised: per-stage table, and its JSON form.
   nlohmann::json collect();

@@ -95,7 +95,11 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
   // Moeller-Trumbore, switching on it at the compiler's occupancy.
   with_features(g.view.material_kinds, [&](auto kinds) {
     constexpr uint32_t K = decltype(kinds)::value;
-    auto go = [&](auto kernel) { launch.launch("pixel", kernel, 0, g.view, g.bvh, c, spp, total, film, counters.get()); };
+    // A thread a sample at most: a small frame leaves no warp without a chunk.
+    const uint64_t threads = (total + 31) / 32 * 32;
+    auto go = [&](auto kernel) {
+      launch.launch_persistent("pixel", kernel, threads, g.view, g.bvh, c, spp, total, film, counters.get());
+    };
     constexpr int kAny = kAnyKind;
     if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny, 1>) : go(k_pixel<false, K, double, true, kAny, 1>);
     else if (!watertight) variance ? go(k_pixel<true, K, float, false, kAny, 1>) : go(k_pixel<false, K, float, false, kAny, 1>);

@@ -18,7 +18,10 @@ namespace pb::gpu {
 
 // body(k) for chunks k < end; `counter` (zero on entry) hands out the chunks from `fixed`
 // on. All 32 lanes of a warp call it and body(k) (k is warp-uniform). Index: uint32_t or
-// unsigned long long (atomicAdd's types).
+// unsigned long long (atomicAdd's types). `fixed` >= end + warps: no claim at all. Warps
+// beyond the work should not claim (claims queue on one address): static_chunks makes a
+// launch with no more chunks than warps all static, and the megakernel's grid is no larger
+// than its chunks (Launcher::launch_persistent).
 template <class Index, class Body>
 __device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* counter, Body&& body) {
   const Index warp = grid_thread() >> 5, warps = grid_threads() >> 5;
@@ -36,9 +39,11 @@ __device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* co
 }
 
 // The wavefront's split: every full round of the grid stride static but the last
-// `counter_rounds`; those and the partial round from the counter.
+// `counter_rounds`; those and the partial round from the counter. No more chunks than
+// warps: all static (no warp takes two, so there is nothing to balance).
 __device__ __forceinline__ uint32_t static_chunks(uint32_t end, uint32_t counter_rounds) {
   const uint32_t warps = grid_threads() >> 5, rounds = end / warps;
+  if (end <= warps) return end + warps;  // for_each_chunk: no claims
   return rounds > counter_rounds ? (rounds - counter_rounds) * warps : 0;
 }
 

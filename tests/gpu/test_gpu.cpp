@@ -120,6 +120,22 @@ INSTANTIATE_TEST_SUITE_P(Cases, GpuStrategies,
                            return n;
                          });
 
+// A frame with many more chunks of 32 samples than the device has warps: the megakernel
+// takes them all from its counter, the wavefront's stages their last rounds
+// (work_chunks.cuh); the tests above, whose frames are smaller than one round, take theirs
+// by grid stride. Every sample still rendered once: films bit-identical, paths = samples.
+TEST(GpuWorkChunks, BitIdenticalWhenWorkComesFromTheCounters) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  const GpuScene gs(scene);
+  RenderSettings s = small_settings(Strategy::Pixel, 128, 64);  // 1 M samples, 32,768 chunks
+  const Film pixel = render_gpu(scene, gs, s);
+  s.strategy = Strategy::Wavefront;
+  expect_identical(pixel, render_gpu(scene, gs, s), "pixel vs wavefront (default pool)");
+  s.paths_in_flight = 100003;  // ~3,100 chunks an iteration: a round or two of any stage
+  expect_identical(pixel, render_gpu(scene, gs, s), "pixel vs wavefront (pool of 100,003)");
+}
+
 // GPU against the CPU tracer, same seed and settings: with one random stream the
 // images differ only where rounding sends a path to another triangle.
 void gpu_vs_cpu(const char* name) {
