@@ -40,15 +40,15 @@ __device__ __forceinline__ unsigned long long warp_sum_u64(unsigned long long v)
          (static_cast<unsigned long long>(__reduce_add_sync(kFullMask, hi)) << 44);
 }
 
+// A lane that adds nothing takes this key: no pixel has it (pixels < 2^31,
+// RenderSettings::validate), so its run never reaches the film.
+constexpr uint32_t kNoPixel = 0xFFFFFFFFu;
+
 // Film add for a whole warp (all 32 lanes call it, convergent): samples of the same
 // pixel in consecutive lanes are summed first (exact integer sums), then one atomic per
 // pixel and channel. Strategies that hand out consecutive samples of a pixel to
 // neighbouring lanes thus need ~1/32 of the atomics, and no lane of a warp waits on
 // 32 same-address atomics.
-// A lane that adds nothing takes this key: no pixel has it (pixels < 2^31,
-// RenderSettings::validate), so its run never reaches the film.
-constexpr uint32_t kNoPixel = 0xFFFFFFFFu;
-
 template <bool kVariance>
 __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uint32_t pixel, const Vec3f& L,
                                               unsigned long long* discarded) {
