@@ -14,6 +14,9 @@ set -uo pipefail
 out=${1:?usage: scripts/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}
 patch_file=$(realpath "${2:?usage: scripts/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}")
 cases=${3:+$(realpath "$3")}
+for f in "$patch_file" ${cases:+"$cases"}; do  # before anything is made
+  if [ ! -f "$f" ] || [ ! -r "$f" ]; then echo "gpu_record.sh: $f: not a readable file" >&2; exit 2; fi
+done
 mkdir -p "$out"
 out=$(realpath "$out")
 cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
