@@ -127,7 +127,7 @@ void preset_gpu_layouts() {
   for (const char* scene : {"paper-cornell", "paper-cornell-ico:0", "paper-cornell-ico:1", "paper-cornell-ico:2",
                             "paper-cornell-ico:8"})
     register_gpu_raycast_benchmarks({scene, 256, 256}, {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,
-                                                        GpuBvhLayout::Brute});
+                                                        GpuBvhLayout::Brute, GpuBvhLayout::Leaves});
 #else
   fmt::print(stderr, "pathbench-bench: --preset gpu-layouts needs a CUDA build (PATHBENCH_CUDA=ON)\n");
   std::exit(2);

@@ -2,7 +2,7 @@
 // Embree ones of raycast_bench.cpp and on the same stored rays.
 //   raycast/gpu/<closest|any>/<coherent|incoherent>/<scene>           (the default layout)
 //   raycast/gpu/<closest|any>/<coherent|incoherent>/<scene>/<layout>  (binary, wide4, wide8,
-//                                                                     brute: bvh_layout.h)
+//                                                                     brute, leaves: bvh_layout.h)
 // Each iteration is one launch of the traversal kernel over every ray (the stored rays
 // repeated to at least 4 M), timed with CUDA events after a warm-up launch
 // (UseManualTime).
@@ -64,6 +64,11 @@ void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit
       if (layout == gpu::GpuBvhLayout::Brute && scene->triangles.size() > kBruteBenchMaxTriangles) {
         state.SkipWithError(fmt::format("brute force on {} triangles: over {}", scene->triangles.size(),
                                         kBruteBenchMaxTriangles).c_str());
+        return;
+      }
+      if (layout == gpu::GpuBvhLayout::Leaves && scene->triangles.size() > gpu::kLeavesMaxTriangles) {
+        state.SkipWithError(fmt::format("leaves on {} triangles: over {}", scene->triangles.size(),
+                                        gpu::kLeavesMaxTriangles).c_str());
         return;
       }
       const RaySets rays = make_ray_sets(*scene, *cpu::make_embree_scene(*scene, RenderSettings{}.watertight), c.width,

@@ -2,8 +2,8 @@
 # Builds, tests, sanitizes and benchmarks the GPU tracer on a GPU host (the device
 # machine), writing everything under $OUT (default: ./device-out). Phases are chosen
 # by arguments: build test sanitize bench ico accuracy layouts (default: all but layouts).
-#   layouts: the GPU BVH layouts (PATHBENCH_GPU_BVH: binary, wide4, wide8, brute)
-#   side by side, interleaved: paper-cornell and ico:8 renders, raw ray casts
+#   layouts: the GPU BVH layouts (PATHBENCH_GPU_BVH: binary, wide4, wide8, brute, leaves)
+#   side by side, interleaved: paper-cornell, ico:0-2 and ico:8 renders, raw ray casts
 #   (pathbench-bench --preset gpu-layouts), and the GPU tests in each layout.
 #   source .gpu-deps/unpack.sh is done here; see ../shared/gpu-host/README.md.
 set -uo pipefail
@@ -117,7 +117,8 @@ fi
 in_budget() { [ "$SECONDS" -lt "${LAYOUTS_BUDGET_S:-500}" ] || { log "skipped (past ${LAYOUTS_BUDGET_S:-500} s): $*"; return 1; }; }
 
 if has layouts; then
-  layouts=${LAYOUTS:-binary wide4 wide8 brute}
+  layouts=${LAYOUTS:-binary wide4 wide8 brute leaves}
+  big_layouts=$(for l in $layouts; do [[ $l == brute || $l == leaves ]] || echo -n "$l "; done)  # for ico:8
   ico="--scene paper-cornell-ico:8 --width 256 --height 256 --spp 800 --bounces 2 --sampling nee"
   log "GPU BVH layouts: paper-cornell 256x256x800 nee, rounds interleaved ($layouts)"
   for round in 1 2 3; do
@@ -126,11 +127,20 @@ if has layouts; then
   for round in 1 2; do
     for l in $layouts; do export PATHBENCH_GPU_BVH=$l; render layout-paper-wavefront-$l-$round $paper --strategy wavefront; done
   done
-  log "GPU BVH layouts: paper-cornell-ico:8 (brute force left out: 1.31 M triangles)"
+  log "GPU BVH layouts: small scenes (paper-cornell-ico:0..2, 256x256x800 nee pixel), where the tiny-scene layouts end"
   for round in 1 2; do
-    for l in ${layouts/brute/}; do export PATHBENCH_GPU_BVH=$l; render layout-ico-pixel-$l-$round $ico --strategy pixel; done
+    for n in 0 1 2; do
+      for l in $layouts; do
+        export PATHBENCH_GPU_BVH=$l
+        render layout-ico$n-pixel-$l-$round ${paper/paper-cornell/paper-cornell-ico:$n} --strategy pixel
+      done
+    done
   done
-  for l in ${layouts/brute/}; do export PATHBENCH_GPU_BVH=$l; render layout-ico-wavefront-$l $ico --strategy wavefront; done
+  log "GPU BVH layouts: paper-cornell-ico:8 (brute force and leaves left out: 1.31 M triangles)"
+  for round in 1 2; do
+    for l in $big_layouts; do export PATHBENCH_GPU_BVH=$l; render layout-ico-pixel-$l-$round $ico --strategy pixel; done
+  done
+  for l in $big_layouts; do export PATHBENCH_GPU_BVH=$l; render layout-ico-wavefront-$l $ico --strategy wavefront; done
   for l in $layouts; do
     export PATHBENCH_GPU_BVH=$l
     timeout 60 $PB render --device gpu --quiet $paper --strategy pixel --profile > "$OUT/logs/layout-profile-$l.txt" 2>&1
@@ -141,7 +151,7 @@ if has layouts; then
 import glob, json, os, re, statistics, sys
 runs = {}
 for f in glob.glob(os.path.join(sys.argv[1], "layout-*.json")):
-    m = re.match(r"layout-(paper|ico)-(pixel|wavefront)-(\w+?)(?:-\d+)?\.json$", os.path.basename(f))
+    m = re.match(r"layout-(paper|ico\d?)-(pixel|wavefront)-(\w+?)(?:-\d+)?\.json$", os.path.basename(f))
     if not m:
         continue
     try:
@@ -170,7 +180,7 @@ for r in rows:
         print(f"{r['name']:64s} {r.get('error_message', 'no rate')}")
 PY
   log "GPU tests in each layout (ctest -L gpu)"
-  for l in ${CTEST_LAYOUTS:-wide8 brute binary wide4}; do
+  for l in ${CTEST_LAYOUTS:-leaves wide8 brute binary wide4}; do
     in_budget "ctest -L gpu in layout $l" || continue
     export PATHBENCH_GPU_BVH=$l
     (cd $B && ctest -L gpu --output-on-failure -V --timeout 300) > "$OUT/logs/ctest-gpu-$l.txt" 2>&1

@@ -17,7 +17,33 @@ constexpr struct {
   GpuBvhLayout layout;
   const char* name;
 } kNames[] = {{GpuBvhLayout::Auto, "auto"},   {GpuBvhLayout::Binary, "binary"}, {GpuBvhLayout::Wide4, "wide4"},
-              {GpuBvhLayout::Wide8, "wide8"}, {GpuBvhLayout::Brute, "brute"}};
+              {GpuBvhLayout::Wide8, "wide8"}, {GpuBvhLayout::Brute, "brute"},   {GpuBvhLayout::Leaves, "leaves"}};
+
+// The binary BVH's leaves in depth-first order, each with the box its parent node holds
+// for it (padded by the builder), for the leaves layout.
+std::vector<LeafBox> leaf_boxes(const BvhHost& bvh) {
+  std::vector<LeafBox> out;
+  std::vector<uint32_t> stack;
+  if (!bvh.nodes.empty()) stack.push_back(0);
+  while (!stack.empty()) {
+    const BvhNode& n = bvh.nodes[stack.back()];
+    stack.pop_back();
+    for (int c = 1; c >= 0; --c) {  // child 0 ends up on top: visited first
+      if (!is_leaf(n.child[c])) {
+        stack.push_back(n.child[c]);
+        continue;
+      }
+      if (n.x[2 * c] > n.x[2 * c + 1]) continue;  // the empty box beside a one-leaf scene (bvh_build.cpp)
+      LeafBox l{};
+      l.lo[0] = n.x[2 * c]; l.hi[0] = n.x[2 * c + 1];
+      l.lo[1] = n.y[2 * c]; l.hi[1] = n.y[2 * c + 1];
+      l.lo[2] = n.z[2 * c]; l.hi[2] = n.z[2 * c + 1];
+      l.ref = n.child[c];
+      out.push_back(l);
+    }
+  }
+  return out;
+}
 }  // namespace
 
 const char* to_string(GpuBvhLayout l) {
@@ -30,7 +56,7 @@ const char* to_string(GpuBvhLayout l) {
 GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what) {
   for (const auto& n : kNames)
     if (name == n.name) return n.layout;
-  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute)", what, name));
+  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute, leaves)", what, name));
 }
 
 GpuBvhOptions GpuBvhOptions::from_env(Instancing instancing) {
@@ -52,7 +78,8 @@ GpuBvhOptions GpuBvhOptions::from_env(Instancing instancing) {
 GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles, size_t instances) {
   if (use_instancing(o.instancing, instances)) return GpuBvhLayout::TwoLevel;
   if (o.layout != GpuBvhLayout::Auto) return o.layout;
-  return triangles <= o.brute_max_triangles ? GpuBvhLayout::Brute : kAutoLayout;
+  if (triangles <= o.brute_max_triangles) return GpuBvhLayout::Brute;
+  return triangles <= kLeavesAutoMaxTriangles && instances == 0 ? GpuBvhLayout::Leaves : kAutoLayout;
 }
 
 SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
@@ -73,7 +100,14 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
       bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
     }
   } else {
-    const bool wide = out.layout != GpuBvhLayout::Binary;
+    if (out.layout == GpuBvhLayout::Leaves && !scene.instances.empty())
+      throw InputError(fmt::format("GPU BVH layout leaves: scene '{}' has instances, whose ties the leaves traversal does "
+                                   "not order (binary, wide4, wide8, brute or --instancing do)", scene.name));
+    if (out.layout == GpuBvhLayout::Leaves && scene.triangles.size() > kLeavesMaxTriangles)
+      throw InputError(fmt::format("GPU BVH layout leaves: scene '{}' has {} triangles; it tests every leaf's box for "
+                                   "every ray and takes at most {} (binary suits it)", scene.name,
+                                   scene.triangles.size(), kLeavesMaxTriangles));
+    const bool wide = out.layout == GpuBvhLayout::Wide4 || out.layout == GpuBvhLayout::Wide8;
     BvhBuildOptions bo;
     if (wide) bo.max_leaf_size = kWideMaxLeafTris;  // a wide leaf holds up to 3
     out.binary = build_bvh(scene, bo);
@@ -83,6 +117,10 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
     if (wide) {
       out.wide = collapse_bvh(out.binary, out.layout == GpuBvhLayout::Wide4 ? 4 : 8);
       out.binary = BvhHost{};
+    }
+    if (out.layout == GpuBvhLayout::Leaves) {
+      out.leaves = leaf_boxes(out.binary);
+      out.binary.nodes.clear();  // the triangles stay, in leaf order
     }
   }
   out.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -107,22 +145,29 @@ BvhView SceneBvhHost::view() const {
       v.kind = TraversalKind::TwoLevel;
       v.two_level = two_level.view();
       break;
+    case GpuBvhLayout::Leaves:
+      v.kind = TraversalKind::Leaves;
+      v.leaves = {leaves.data(), binary.tris.data(), uint32_t(leaves.size()), uint32_t(binary.tris.size())};
+      break;
     default:
       v.kind = TraversalKind::Binary;
       v.binary = binary.view();
   }
-  v.binary.exact_ties = v.wide.exact_ties = v.exact_ties = exact_ties ? 1u : 0u;
+  v.binary.exact_ties = v.wide.exact_ties = v.leaves.exact_ties = v.exact_ties = exact_ties ? 1u : 0u;
   return v;
 }
 
 uint64_t SceneBvhHost::bytes() const {
-  return binary.bytes() + wide.bytes() + all.size() * sizeof(BvhTriangle) + two_level.bytes();
+  return binary.bytes() + wide.bytes() + all.size() * sizeof(BvhTriangle) + leaves.size() * sizeof(LeafBox) +
+         two_level.bytes();
 }
 uint32_t SceneBvhHost::nodes() const {
-  return uint32_t(binary.nodes.size() + wide.nodes.size() + two_level.top_nodes.size() + two_level.bottom_nodes.size());
+  return uint32_t(binary.nodes.size() + wide.nodes.size() + leaves.size() + two_level.top_nodes.size() +
+                  two_level.bottom_nodes.size());
 }
 uint32_t SceneBvhHost::node_bytes() const {
   if (layout == GpuBvhLayout::Brute) return 0;
+  if (layout == GpuBvhLayout::Leaves) return uint32_t(sizeof(LeafBox));
   return layout == GpuBvhLayout::Binary || layout == GpuBvhLayout::TwoLevel ? uint32_t(sizeof(BvhNode))
                                                                             : uint32_t(sizeof(WideNode));
 }

@@ -23,6 +23,7 @@ struct GpuScene::Impl {
   DeviceBuffer<float> emitter_cdf;
   DeviceBuffer<BvhNode> nodes;      // the layout's nodes: binary...
   DeviceBuffer<WideNode> wide_nodes;  // ...or wide (brute force has none)
+  DeviceBuffer<LeafBox> leaf_boxes;  // ...or the leaves layout's boxes
   DeviceBuffer<BvhTriangle> tris;    // in traversal order (brute force: scene order)
   // The two-level BVH's (two_level_bvh.h; its triangles are `positions` and `triangles`).
   DeviceBuffer<BvhNode> top_nodes, bottom_nodes;

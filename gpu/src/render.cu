@@ -220,6 +220,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
               {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
               {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
                           : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"
+                          : g.layout == GpuBvhLayout::Leaves ? "embree rtcBuildBVH, binned SAH, binary: its leaves, no inner nodes"
                           : g.layout == GpuBvhLayout::TwoLevel
                               ? "embree rtcBuildBVH, binned SAH, binary: over the instances, and one per prototype"
                               : "embree rtcBuildBVH, binned SAH, binary (leaves <= 3), collapsed greedily"}};

@@ -27,8 +27,9 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.emitter_cdf.assign(scene.emitter_cdf, "emitter table", lower);
   m.nodes.assign(bvh.binary.nodes, "BVH nodes", lower);
   m.wide_nodes.assign(bvh.wide.nodes, "BVH nodes", lower);
-  m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : bvh.layout == GpuBvhLayout::Binary ? bvh.binary.tris
-                                                                                                  : bvh.wide.tris,
+  m.leaf_boxes.assign(bvh.leaves, "BVH nodes", lower);
+  const bool binary_tris = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::Leaves;
+  m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : binary_tris ? bvh.binary.tris : bvh.wide.tris,
                 "BVH triangles", lower);
   const TwoLevelHost& two = bvh.two_level;
   m.top_nodes.assign(two.top_nodes, "BVH nodes", lower);
@@ -49,9 +50,11 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh.wide = {m.wide_nodes.get(), m.tris.get(), uint32_t(m.wide_nodes.size()), uint32_t(m.tris.size()),
                 m.bvh.exact_ties};
   m.bvh.tris = m.tris.get();
+  m.bvh.leaves = {m.leaf_boxes.get(), m.tris.get(), uint32_t(m.leaf_boxes.size()), uint32_t(m.tris.size()),
+                m.bvh.exact_ties};
   m.bvh.two_level = {m.top_nodes.get(), m.top_items.get(), m.instances.get(), m.bottom_nodes.get(),
                      m.bottom_items.get(), m.positions.get(), m.triangles.get()};
-  m.bvh_bytes = m.nodes.bytes() + m.wide_nodes.bytes() + m.tris.bytes() + m.top_nodes.bytes() +
+  m.bvh_bytes = m.nodes.bytes() + m.wide_nodes.bytes() + m.leaf_boxes.bytes() + m.tris.bytes() + m.top_nodes.bytes() +
                 m.bottom_nodes.bytes() + m.top_items.bytes() + m.bottom_items.bytes() + m.instances.bytes();
   m.bytes = m.positions.bytes() + m.triangles.bytes() + m.material_ids.bytes() + m.materials.bytes() +
             m.emitters.bytes() + m.emitter_cdf.bytes() + m.bvh_bytes;
@@ -63,6 +66,10 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh_tris = uint32_t(m.tris.size());
   m.bvh_depth = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_depth : bvh.wide.depth;
   m.bvh_leaves = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_leaves : bvh.wide.leaves;
+  if (bvh.layout == GpuBvhLayout::Leaves) {  // one level: the leaves
+    m.bvh_depth = 1;
+    m.bvh_leaves = uint32_t(bvh.leaves.size());
+  }
   if (bvh.layout == GpuBvhLayout::TwoLevel) {  // the deepest top-to-triangle path; triangle references
     m.bvh_depth = two.top_depth + two.bottom_depth;
     m.bvh_tris = uint32_t(two.bottom_items.size());

@@ -276,7 +276,8 @@ TEST(GpuVsCpu, CornellBoxGgx) {  // rough conductor
 TEST(GpuTraversal, DeviceMatchesHostAndEmbree) {
   PB_REQUIRE_GPU();
   for (const char* name : {"paper-cornell", "paper-cornell-ico:3"})
-  for (GpuBvhLayout layout : {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8, GpuBvhLayout::Brute}) {
+  for (GpuBvhLayout layout :
+       {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8, GpuBvhLayout::Brute, GpuBvhLayout::Leaves}) {
     Scene scene;
     try {
       scene = load_scene(name);

@@ -1,8 +1,7 @@
 // Host-side checks of the GPU tracer's BVH (built by Embree's builder) and its
 // host+device traversal with the watertight triangle test, against Embree's own
-// intersector on the same rays, in every layout (binary, wide4, wide8, brute force:
-// bvh_layout.h); the wide and brute-force layouts also against the binary BVH, hit for
-// hit. Runs without a GPU (CTest label `unit`).
+// intersector on the same rays, in every layout (binary, wide4, wide8, brute force,
+// leaves: bvh_layout.h); the other layouts also against the binary BVH, hit for hit. Runs without a GPU (CTest label `unit`).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,9 +73,10 @@ class Traversal : public ::testing::TestWithParam<SceneCase> {
 };
 
 TEST_P(Traversal, BvhReferencesEveryTriangle) {
-  const std::vector<BvhTriangle>& tris = bvh_.layout == GpuBvhLayout::Brute    ? bvh_.all
-                                         : bvh_.layout == GpuBvhLayout::Binary ? bvh_.binary.tris
-                                                                               : bvh_.wide.tris;
+  const bool binary_tris = bvh_.layout == GpuBvhLayout::Binary || bvh_.layout == GpuBvhLayout::Leaves;
+  const std::vector<BvhTriangle>& tris = bvh_.layout == GpuBvhLayout::Brute ? bvh_.all
+                                         : binary_tris                      ? bvh_.binary.tris
+                                                                            : bvh_.wide.tris;
   std::vector<int> seen(scene_.triangles.size(), 0);
   for (const BvhTriangle& t : tris) {
     ASSERT_LT(t.prim, scene_.triangles.size());
@@ -91,6 +91,21 @@ TEST_P(Traversal, BvhReferencesEveryTriangle) {
   if (bvh_.layout == GpuBvhLayout::Wide4 || bvh_.layout == GpuBvhLayout::Wide8) {
     EXPECT_EQ(tris.size(), scene_.triangles.size());  // each triangle in exactly one leaf
     EXPECT_LT(depth + 1, uint32_t(kWideStackSize));
+  }
+  if (bvh_.layout == GpuBvhLayout::Leaves) {  // every triangle slot in exactly one leaf, no inner nodes
+    EXPECT_TRUE(bvh_.binary.nodes.empty());
+    std::vector<int> slot(tris.size(), 0);
+    for (const LeafBox& l : bvh_.leaves)
+      for (uint32_t i = leaf_first(l.ref); i < leaf_first(l.ref) + leaf_count(l.ref); ++i) {
+        ASSERT_LT(i, tris.size());
+        ++slot[i];
+        for (const float* v : {tris[i].v0, tris[i].v1, tris[i].v2})
+          for (int k = 0; k < 3; ++k) {  // the leaf's box holds its triangles
+            EXPECT_LE(l.lo[k], v[k]);
+            EXPECT_GE(l.hi[k], v[k]);
+          }
+      }
+    for (size_t i = 0; i < slot.size(); ++i) EXPECT_EQ(slot[i], 1) << "triangle slot " << i;
   }
   std::printf("[ INFO     ] %s %s: %zu triangles, %u nodes of %u bytes, %.2f MB, depth %u (binary: depth %u, %u "
               "leaves, SAH %.2f), built in %.3f s\n",
@@ -177,7 +192,10 @@ INSTANTIATE_TEST_SUITE_P(
                       SceneCase{"paper-cornell", true, GpuBvhLayout::Wide4},
                       SceneCase{"paper-cornell-ico:3", true, GpuBvhLayout::Wide4},
                       SceneCase{"cornell-box", false, GpuBvhLayout::Wide4},
-                      SceneCase{"paper-cornell", true, GpuBvhLayout::Brute}),
+                      SceneCase{"paper-cornell", true, GpuBvhLayout::Brute},
+                      SceneCase{"paper-cornell", true, GpuBvhLayout::Leaves},
+                      SceneCase{"paper-cornell-ico:3", true, GpuBvhLayout::Leaves},
+                      SceneCase{"cornell-box", false, GpuBvhLayout::Leaves}),
     case_name);
 
 // Every layout against the binary BVH on the same rays, by the rules the Embree
@@ -249,7 +267,7 @@ TEST(LayoutsAgreeScaled, TinyAndHugeScenes) {
     Scene scene = load_scene("paper-cornell-ico:2");
     for (Vec3f& p : scene.positions) p = p * scale + Vec3f{0.5f, -0.25f, 0.125f} * scale;
     scene.finalize();
-    for (GpuBvhLayout l : {GpuBvhLayout::Wide8, GpuBvhLayout::Wide4, GpuBvhLayout::Brute})
+    for (GpuBvhLayout l : {GpuBvhLayout::Wide8, GpuBvhLayout::Wide4, GpuBvhLayout::Brute, GpuBvhLayout::Leaves})
       expect_same_hits_as_binary(scene, l, "paper-cornell-ico:2 x " + std::to_string(scale));
   }
 }
@@ -260,6 +278,10 @@ INSTANTIATE_TEST_SUITE_P(Layouts, LayoutsAgree,
                                            SceneCase{"paper-cornell", true, GpuBvhLayout::Brute},
                                            SceneCase{"paper-cornell-ico:0", true, GpuBvhLayout::Brute},
                                            SceneCase{"paper-cornell-ico:1", true, GpuBvhLayout::Brute},
+                                           SceneCase{"paper-cornell", true, GpuBvhLayout::Leaves},
+                                           SceneCase{"paper-cornell-ico:1", true, GpuBvhLayout::Leaves},
+                                           SceneCase{"paper-cornell-ico:0", true, GpuBvhLayout::Leaves},
+                                           SceneCase{"cornell-box", false, GpuBvhLayout::Leaves},
                                            SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::Wide8},
                                            SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::Wide4},
                                            SceneCase{"cornell-box", false, GpuBvhLayout::Wide8}),
@@ -308,7 +330,8 @@ TEST(Watertight, RespectsTheInterval) {
 TEST(Bvh, EmptySceneMissesEverything) {
   Scene s;
   s.name = "empty";
-  for (GpuBvhLayout l : {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8, GpuBvhLayout::Brute}) {
+  for (GpuBvhLayout l :
+       {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8, GpuBvhLayout::Brute, GpuBvhLayout::Leaves}) {
     GpuBvhOptions o;
     o.layout = l;
     const SceneBvhHost bvh = build_scene_bvh(s, o);
@@ -331,7 +354,7 @@ TEST(BvhLayout, AutoAndNames) {
   o.layout = GpuBvhLayout::Binary;
   EXPECT_EQ(resolve_layout(o, 5), GpuBvhLayout::Binary);
   for (GpuBvhLayout l : {GpuBvhLayout::Auto, GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,
-                         GpuBvhLayout::Brute})
+                         GpuBvhLayout::Brute, GpuBvhLayout::Leaves})
     EXPECT_EQ(parse_gpu_bvh_layout(to_string(l)), l);
   try {
     parse_gpu_bvh_layout("wide16");

@@ -170,6 +170,29 @@ PB_HD uint32_t finish_closest(const BvhTriangle* tris, const Vec3f& o, const Vec
   return hit;
 }
 
+// Bits of a mask: the traversals' child and leaf masks.
+PB_HD uint32_t highest_bit(uint32_t v) {  // v != 0
+#if defined(__CUDA_ARCH__)
+  return 31u - uint32_t(__clz(v));
+#else
+  return 31u - uint32_t(__builtin_clz(v));
+#endif
+}
+PB_HD uint32_t lowest_bit(uint32_t v) {  // v != 0
+#if defined(__CUDA_ARCH__)
+  return uint32_t(__ffs(v)) - 1u;
+#else
+  return uint32_t(__builtin_ctz(v));
+#endif
+}
+PB_HD uint32_t popcount(uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return uint32_t(__popc(v));
+#else
+  return uint32_t(__builtin_popcount(v));
+#endif
+}
+
 // The slab test's per-ray constants: t of the plane x = X is fmadd(X, inv.x, oi.x).
 struct SlabRay {
   Vec3f inv, oi;
@@ -205,6 +228,19 @@ PB_HD float slab_max(float a, float b) {
 #endif
 }
 
+// The slab test of one box [x0, x1] x [y0, y1] x [z0, z1]: the ray enters it at tn and
+// leaves at tf (clamped to [0, t], the far end widened: kFarScale); it passes through the
+// box before t if tn <= tf. A binary node's two children and a leaf of the leaves layout (leaf_list.h).
+PB_HD void slab_interval(float x0, float x1, float y0, float y1, float z0, float z1, const SlabRay& r, float t,
+                         float& tn, float& tf) {
+  const float tx0 = fmadd(x0, r.inv.x, r.oi.x), tx1 = fmadd(x1, r.inv.x, r.oi.x);
+  const float ty0 = fmadd(y0, r.inv.y, r.oi.y), ty1 = fmadd(y1, r.inv.y, r.oi.y);
+  const float tz0 = fmadd(z0, r.inv.z, r.oi.z), tz1 = fmadd(z1, r.inv.z, r.oi.z);
+  tn = slab_max(slab_max(slab_min(tx0, tx1), slab_min(ty0, ty1)), slab_max(slab_min(tz0, tz1), 0.0f));
+  tf = slab_min(slab_min(slab_max(tx0, tx1), slab_max(ty0, ty1)), slab_max(tz0, tz1)) * kFarScale;
+  tf = slab_min(tf, t);
+}
+
 }  // namespace detail
 
 namespace detail {
@@ -217,7 +253,7 @@ namespace detail {
 template <class Leaf>
 PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, const float& t, Leaf&& leaf,
                        TraversalStats* stats) {
-  const auto [inv, oi] = make_slab_ray(o, d);
+  const SlabRay sr = make_slab_ray(o, d);
   uint32_t stack[kTraversalStackSize];
   int sp = 0;
   uint32_t ref = 0;
@@ -228,14 +264,8 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
       load_node(nodes, ref, x, y, z, child);
       if (stats) ++stats->nodes;
       float tn[2], tf[2];
-      for (int c = 0; c < 2; ++c) {
-        const float tx0 = fmadd(x[2 * c], inv.x, oi.x), tx1 = fmadd(x[2 * c + 1], inv.x, oi.x);
-        const float ty0 = fmadd(y[2 * c], inv.y, oi.y), ty1 = fmadd(y[2 * c + 1], inv.y, oi.y);
-        const float tz0 = fmadd(z[2 * c], inv.z, oi.z), tz1 = fmadd(z[2 * c + 1], inv.z, oi.z);
-        tn[c] = slab_max(slab_max(slab_min(tx0, tx1), slab_min(ty0, ty1)), slab_max(slab_min(tz0, tz1), 0.0f));
-        tf[c] = slab_min(slab_min(slab_max(tx0, tx1), slab_max(ty0, ty1)), slab_max(tz0, tz1)) * kFarScale;
-        tf[c] = slab_min(tf[c], t);
-      }
+      for (int c = 0; c < 2; ++c)
+        slab_interval(x[2 * c], x[2 * c + 1], y[2 * c], y[2 * c + 1], z[2 * c], z[2 * c + 1], sr, t, tn[c], tf[c]);
       const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
       if (h0 && h1) {
         const bool swap = tn[1] < tn[0];

@@ -3,7 +3,10 @@
 //   binary  the binary BVH (bvh.h), 64-byte nodes;
 //   wide4 / wide8  the compressed wide BVH (wide_bvh.h), 80-byte nodes of <= 4 / 8 children;
 //   brute   no BVH: every triangle tested (brute_force.h), for tiny scenes;
-//   auto    brute at most `brute_max_triangles` triangles, else kAutoLayout;
+//   leaves  the binary BVH's leaves, each with its box, and no inner nodes
+//           (leaf_list.h), for tiny scenes without instances;
+//   auto    brute at most `brute_max_triangles` triangles, else leaves up to
+//           kLeavesAutoMaxTriangles (a scene without instances), else kAutoLayout;
 //   two-level  the instanced scene's (two_level_bvh.h): not asked for by name but by
 //           GpuBvhOptions::instancing (--instancing), on a scene with instances.
 // The choice comes from GpuBvhOptions (GpuScene's constructor: one process can A/B
@@ -24,7 +27,7 @@
 
 namespace pb::gpu {
 
-enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5 };
+enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6 };
 
 // Measured on an H100 (results/nvidia-h100-80gb-hbm3/layouts-a12fc4c, interleaved,
 // CUDA events): the binary BVH is the fastest everywhere we measured — paper-cornell
@@ -34,6 +37,10 @@ enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3,
 constexpr GpuBvhLayout kAutoLayout = GpuBvhLayout::Binary;
 constexpr uint32_t kDefaultBruteMaxTriangles = 0;
 constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute force is never the answer
+// auto's leaves layout: up to this many triangles (a scene without instances).
+constexpr uint32_t kLeavesAutoMaxTriangles = 0;
+// The leaves layout tests every leaf's box for every ray: asked for by name, up to this many.
+constexpr uint32_t kLeavesMaxTriangles = 1u << 16;
 
 struct GpuBvhOptions {
   GpuBvhLayout layout = GpuBvhLayout::Auto;
@@ -59,6 +66,7 @@ struct SceneBvhHost {
   BvhHost binary;                  // Binary
   WideBvhHost wide;                // Wide4, Wide8
   std::vector<BvhTriangle> all;    // Brute: the triangles in scene order
+  std::vector<LeafBox> leaves;    // Leaves: the leaves of `binary`, whose triangles it keeps (no nodes)
   TwoLevelHost two_level;          // TwoLevel
   uint32_t binary_depth = 0, binary_leaves = 0;  // the binary BVH the wide one came from
   double binary_sah = 0, build_seconds = 0;
@@ -69,7 +77,7 @@ struct SceneBvhHost {
   BvhView view() const;  // host pointers
   uint64_t bytes() const;
   uint32_t nodes() const;
-  uint32_t node_bytes() const;  // one node's size (0 for brute force)
+  uint32_t node_bytes() const;  // one node's size (0 for brute force; leaves: a box)
 };
 
 SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options);

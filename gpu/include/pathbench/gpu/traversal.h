@@ -11,6 +11,7 @@
 #include "pathbench/common/hd.h"
 #include "pathbench/gpu/brute_force.h"
 #include "pathbench/gpu/bvh.h"
+#include "pathbench/gpu/leaf_list.h"
 #include "pathbench/gpu/two_level_bvh.h"
 #include "pathbench/gpu/wide_bvh.h"
 
@@ -18,8 +19,9 @@ namespace pb::gpu {
 
 // Binary: bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
 // brute_force.h, the triangles in scene order in `tris` and no nodes. TwoLevel:
-// two_level_bvh.h, the instanced scene's (--instancing).
-enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3 };
+// two_level_bvh.h, the instanced scene's (--instancing). Leaves: leaf_list.h, the binary
+// BVH's leaves without its inner nodes (tiny scenes without instances).
+enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3, Leaves = 4 };
 
 struct BvhView {
   BvhView() = default;
@@ -32,6 +34,7 @@ struct BvhView {
   uint32_t num_tris = 0;
   uint32_t exact_ties = 0;            // AllTriangles: as BinaryBvhView's
   TwoLevelView two_level{};
+  LeafListView leaves{};
 };
 
 // kKind: a TraversalKind the caller was compiled for (bvh.kind must be it), or
@@ -39,7 +42,7 @@ struct BvhView {
 // instances traced flat (exact_ties set), compiled apart from Binary (exact_ties unset)
 // so that flat scenes' kernels carry no tie compare (bvh.h's traverse, kExact).
 constexpr int kAnyKind = -1;
-constexpr int kBinaryExactTies = 4;
+constexpr int kBinaryExactTies = 5;
 
 template <bool kAnyHit, bool kWatertight = true, int kKind = kAnyKind>
 PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
@@ -54,6 +57,8 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
     return traverse<kAnyHit, kWatertight, 1>(bvh.binary, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::TwoLevel)) {
     return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::Leaves)) {
+    return traverse_leaves<kAnyHit, kWatertight, 0>(bvh.leaves, o, d, t_max, t_hit, stats);  // no instances: no ties rule
   } else {
     switch (bvh.kind) {
       case TraversalKind::Wide: return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
@@ -61,6 +66,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
         return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
       case TraversalKind::AllTriangles:
         return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
+      case TraversalKind::Leaves: return traverse_leaves<kAnyHit, kWatertight>(bvh.leaves, o, d, t_max, t_hit, stats);
       default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
     }
   }
@@ -86,6 +92,7 @@ decltype(auto) with_traversal_kind(const BvhView& bvh, Fn&& fn) {
     case TraversalKind::Wide: return fn(std::integral_constant<int, int(TraversalKind::Wide)>{});
     case TraversalKind::AllTriangles: return fn(std::integral_constant<int, int(TraversalKind::AllTriangles)>{});
     case TraversalKind::TwoLevel: return fn(std::integral_constant<int, int(TraversalKind::TwoLevel)>{});
+    case TraversalKind::Leaves: return fn(std::integral_constant<int, int(TraversalKind::Leaves)>{});
     default: return fn(std::integral_constant<int, int(TraversalKind::Binary)>{});
   }
 }

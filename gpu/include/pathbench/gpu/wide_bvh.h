@@ -59,27 +59,6 @@ struct WideBvhView {
 
 namespace detail {
 
-PB_HD uint32_t highest_bit(uint32_t v) {  // v != 0
-#if defined(__CUDA_ARCH__)
-  return 31u - uint32_t(__clz(v));
-#else
-  return 31u - uint32_t(__builtin_clz(v));
-#endif
-}
-PB_HD uint32_t lowest_bit(uint32_t v) {  // v != 0
-#if defined(__CUDA_ARCH__)
-  return uint32_t(__ffs(v)) - 1u;
-#else
-  return uint32_t(__builtin_ctz(v));
-#endif
-}
-PB_HD uint32_t popcount(uint32_t v) {
-#if defined(__CUDA_ARCH__)
-  return uint32_t(__popc(v));
-#else
-  return uint32_t(__builtin_popcount(v));
-#endif
-}
 PB_HD float exp2_of_byte(uint32_t e) {  // 2^(e - 127) for e in 1..254: a normal float
   const uint32_t bits = e << 23;
 #if defined(__CUDA_ARCH__)
