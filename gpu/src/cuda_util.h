@@ -158,6 +158,9 @@ class Launcher {
     const uint64_t wave = uint64_t(st.full_wave_blocks) * uint64_t(st.block);
     launch(name, kernel, threads < wave ? threads : 0, std::forward<Args>(args)...);
   }
+  // The stream later launches go to (the wavefront's pools take turns on theirs: run_pools).
+  void set_stream(cudaStream_t stream) { stream_ = stream; }
+  cudaStream_t stream() const { return stream_; }
   int block_size(const char* name) const;
   // After the stream is synchronised: per-stage table, and its JSON form.
   nlohmann::json collect();

@@ -54,6 +54,14 @@ class PathPool {
   FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
                   uint64_t total, FilmDev film, bool variance);
 
+  // run() in steps, for pools that share a frame (run_pools): begin() readies the pool for
+  // the frame's samples [first, first + count) on `stream`; step() launches one iteration
+  // (trace, shade) on the launcher's stream and returns false once the host has seen an
+  // iteration with nothing to trace; finish() waits for the stream and returns the result.
+  void begin(cudaStream_t stream, uint64_t first, uint64_t count, const GpuScene::Impl& g);
+  bool step(Launcher& launch, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, FilmDev film, bool variance);
+  FrameResult finish(cudaStream_t stream);
+
  private:
   struct Buffers {
     DeviceBuffer<float4> o, d, beta, L;
@@ -78,6 +86,26 @@ class PathPool {
   // has paths to trace (run reads them while the GPU works, resets them to kNotPlanned).
   static constexpr int kPlanSlots = 8;
   uint32_t* planned_ = nullptr;
+  // The frame in progress (begin .. finish).
+  uint64_t end_ = 0;         // one past its last sample
+  uint64_t it_ = 0;          // iterations launched
+  uint64_t iterations_ = 0;  // iterations the frame took, once step() has returned false
+  uint32_t counter_rounds_ = 0;
+  cudaStream_t stream_ = nullptr;
 };
+
+// Samples a wavefront frame splits among pools on streams of their own, by default: while
+// one pool's kernel drains (its last chunks on a few SMs), the other's fill the rest.
+// PATHBENCH_GPU_WAVEFRONT_POOLS=1..4 overrides it (a bad value: InputError).
+constexpr int kWavefrontPools = 2;
+int wavefront_pools();
+
+// One frame of `total` samples over several pools, each on its own stream (streams[0] the
+// frame's: the others start after what it holds and it ends after them), their iterations
+// launched in turn; `total` split into contiguous ranges. Stats summed, iterations the most
+// any pool took, paths in flight and pool bytes summed.
+FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n, Launcher& launch,
+                      const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, uint64_t total, FilmDev film,
+                      bool variance);
 
 }  // namespace pb::gpu

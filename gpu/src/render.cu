@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include "cuda_util.h"
 #include "device_facts.h"
@@ -122,7 +123,8 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     throw InputError("--no-watertight: the GPU runs the Moeller-Trumbore triangle test with --strategy pixel only");
 
   // Strategy resources.
-  std::unique_ptr<PathPool> pool;
+  std::vector<std::unique_ptr<PathPool>> pools;  // wavefront: wavefront_pools() of them; paper-queue: one
+  std::vector<std::unique_ptr<ScopedStream>> pool_streams;  // the wavefront's pools beyond the first
   DeviceBuffer<PixelCounters> pixel_counters;
   uint64_t warmup_total = std::min<uint64_t>(total, pixels);
   if (settings.strategy == Strategy::Pixel) {
@@ -132,7 +134,13 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     pif = std::min<uint64_t>(pif, total);
     pif = std::max<uint64_t>(pif, 1);
     if (pif > 0xFFFFFFFFull) throw InputError("--paths-in-flight: at most 4294967295 paths");
-    pool = std::make_unique<PathPool>(pif, shadows, "the wavefront path pool", "--paths-in-flight");
+    // Under --profile one pool: each stage's events then bracket its own work alone.
+    const uint64_t n = std::min<uint64_t>(profile ? 1 : uint64_t(wavefront_pools()), pif);
+    for (uint64_t k = 0; k < n; ++k) {  // pif split as evenly as it goes
+      const uint64_t cap = pif * (k + 1) / n - pif * k / n;
+      pools.push_back(std::make_unique<PathPool>(cap, shadows, "the wavefront path pool", "--paths-in-flight"));
+      if (k > 0) pool_streams.push_back(std::make_unique<ScopedStream>());
+    }
   } else {
     // The paper's global queue: a task for every path of the frame, all at once.
     const uint64_t per_task = PathPool::state_bytes(shadows);
@@ -145,7 +153,8 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
           "--width/--height, or use --strategy wavefront (memory bounded by --paths-in-flight)",
           settings.width, settings.height, settings.spp, total, per_task, need / 1e9, info.name, free_b / 1e9,
           total > 0xFFFFFFFFull ? " (and more than 2^32 - 1 tasks cannot be indexed)" : ""));
-    pool = std::make_unique<PathPool>(total, shadows, "the paper-queue global task queue", "--spp or --width/--height");
+    pools.push_back(std::make_unique<PathPool>(total, shadows, "the paper-queue global task queue",
+                                               "--spp or --width/--height"));
     warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
   }
 
@@ -154,7 +163,12 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     if (settings.strategy == Strategy::Pixel)
       return run_pixel(launch, stream.s, g, config, spp, n, fb.view, film.has_variance(), settings.precision,
                        settings.watertight, pixel_counters, occupancy.min_blocks);
-    return pool->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
+    if (pools.size() == 1) return pools[0]->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
+    std::vector<PathPool*> p;
+    std::vector<cudaStream_t> s{stream.s};
+    for (const auto& pool : pools) p.push_back(pool.get());
+    for (const auto& ps : pool_streams) s.push_back(ps->s);
+    return run_pools(p.data(), s.data(), int(p.size()), launch, g, config, spp, n, fb.view, film.has_variance());
   };
 
   // Warm-up (module load, first-touch of every buffer), then the timed frame. A kept
@@ -237,6 +251,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
     x["counter_rounds"] = r.counter_rounds;  // work_chunks.cuh: the stages' last rounds from a counter
+    x["pools"] = pools.size();  // path_pool.cuh: run_pools, each on a stream of its own
   }
   if (settings.strategy == Strategy::PaperQueue) {
     x["bytes_per_task"] = r.state_bytes_per_path;  // the queues are the compacted state buffers themselves

@@ -7,6 +7,7 @@
 #include <ostream>
 #include <string>
 #include <cstdio>
+#include <cstdlib>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
@@ -134,6 +135,39 @@ TEST(GpuWorkChunks, BitIdenticalWhenWorkComesFromTheCounters) {
   expect_identical(pixel, render_gpu(scene, gs, s), "pixel vs wavefront (default pool)");
   s.paths_in_flight = 100003;  // ~3,100 chunks an iteration: a round or two of any stage
   expect_identical(pixel, render_gpu(scene, gs, s), "pixel vs wavefront (pool of 100,003)");
+}
+
+// The wavefront's samples split among 1 to 4 pools on streams of their own (run_pools,
+// PATHBENCH_GPU_WAVEFRONT_POOLS), with pools of uneven size: every sample rendered once,
+// films bit-identical to the megakernel's; the report names the pool count. A count the
+// variable cannot mean is an InputError naming it.
+TEST(GpuWavefrontPools, BitIdenticalForAnyPoolCount) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  const GpuScene gs(scene);
+  RenderSettings s = small_settings(Strategy::Pixel, 96, 32);
+  const Film pixel = render_gpu(scene, gs, s);
+  s.strategy = Strategy::Wavefront;
+  for (const char* pools : {"1", "2", "3", "4"})
+    for (uint64_t pif : {uint64_t(0), uint64_t(10007)}) {  // 0: the default pool
+      ::setenv("PATHBENCH_GPU_WAVEFRONT_POOLS", pools, 1);
+      s.paths_in_flight = pif;
+      RunReport r;
+      const std::string what = std::string("pools ") + pools + ", paths in flight " + std::to_string(pif);
+      expect_identical(pixel, render_gpu(scene, gs, s, &r), what.c_str());
+      EXPECT_EQ(r.extra["pools"], std::stoi(pools)) << what;
+    }
+  ::setenv("PATHBENCH_GPU_WAVEFRONT_POOLS", "5", 1);
+  Film f(s.width, s.height, false);
+  RunReport r;
+  f.begin(s.spp, scene.max_emission());
+  try {
+    render(scene, gs, s, f, r, false);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("PATHBENCH_GPU_WAVEFRONT_POOLS"), std::string::npos) << e.what();
+  }
+  ::unsetenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
 }
 
 // GPU against the CPU tracer, same seed and settings: with one random stream the

@@ -344,13 +344,18 @@ TEST(Bvh, EmptySceneMissesEverything) {
 // The layout choice: auto takes brute force up to the threshold, else the wide BVH; the
 // environment's names are checked, and a bad one is an InputError naming the variable.
 TEST(BvhLayout, AutoAndNames) {
-  // The default, as measured on an H100: the binary BVH, no brute force.
-  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, 14), GpuBvhLayout::Binary);
+  // The default, as measured on an H100: the leaves alone for tiny scenes without instances,
+  // else the binary BVH; no brute force.
+  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, 14), GpuBvhLayout::Leaves);
+  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, kLeavesAutoMaxTriangles), GpuBvhLayout::Leaves);
+  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, kLeavesAutoMaxTriangles + 1), GpuBvhLayout::Binary);
+  EXPECT_EQ(resolve_layout(GpuBvhOptions{}, 14, 2), GpuBvhLayout::Binary);  // instances: ties need the binary rule
   EXPECT_EQ(resolve_layout(GpuBvhOptions{}, 1310734), GpuBvhLayout::Binary);
   GpuBvhOptions o;
   o.brute_max_triangles = 20;
   EXPECT_EQ(resolve_layout(o, 20), GpuBvhLayout::Brute);
-  EXPECT_EQ(resolve_layout(o, 21), kAutoLayout);
+  EXPECT_EQ(resolve_layout(o, 21), GpuBvhLayout::Leaves);
+  EXPECT_EQ(resolve_layout(o, 100), kAutoLayout);
   o.layout = GpuBvhLayout::Binary;
   EXPECT_EQ(resolve_layout(o, 5), GpuBvhLayout::Binary);
   for (GpuBvhLayout l : {GpuBvhLayout::Auto, GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,
@@ -371,6 +376,32 @@ TEST(BvhLayout, AutoAndNames) {
   EXPECT_EQ(e.layout, GpuBvhLayout::Wide4);
   ::unsetenv("PATHBENCH_GPU_BRUTE_MAX_TRIS");
   ::unsetenv("PATHBENCH_GPU_BVH");
+}
+
+// The leaves layout refuses what it cannot serve, naming the layout and the reason: a
+// scene with instances (its ties) and one past kLeavesMaxTriangles.
+TEST(BvhLayout, LeavesRefusesInstancesAndLargeScenes) {
+  GpuBvhOptions o;
+  o.layout = GpuBvhLayout::Leaves;
+  Scene big = load_scene("paper-cornell-ico:7");  // 327,694 triangles
+  ASSERT_GT(big.triangles.size(), size_t(kLeavesMaxTriangles));
+  try {
+    build_scene_bvh(big, o);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("leaves"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("triangles"), std::string::npos) << e.what();
+  }
+  Scene inst = load_scene(std::string(PATHBENCH_SOURCE_DIR) + "/scenes/examples/instancing.json");
+  ASSERT_FALSE(inst.instances.empty());
+  try {
+    build_scene_bvh(inst, o);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("instances"), std::string::npos) << e.what();
+  }
+  o.layout = GpuBvhLayout::Auto;  // auto never picks it there
+  EXPECT_EQ(build_scene_bvh(inst, o).layout, GpuBvhLayout::Binary);
 }
 
 // The quantised child boxes hold the children they stand for: every triangle of a
