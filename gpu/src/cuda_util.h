@@ -139,7 +139,7 @@ class Launcher {
     cfg.dynamicSmemBytes = 0;
     cfg.stream = stream_;
     cfg.attrs = attr;
-    cfg.numAttrs = profile_ ? 0 : 1;
+    cfg.numAttrs = profile_ || !pdl_ ? 0 : 1;
     cudaError_t e = cudaLaunchKernelEx(&cfg, kernel, std::forward<Args>(args)...);
     if (e == cudaSuccess) e = cudaGetLastError();
     if (e != cudaSuccess) cuda_fail(e, name, __FILE__, __LINE__);
@@ -160,6 +160,8 @@ class Launcher {
   }
   // The stream later launches go to (the wavefront's pools take turns on theirs: run_pools).
   void set_stream(cudaStream_t stream) { stream_ = stream; }
+  // Whether launches may start before the previous kernel of their stream ends (PDL, above).
+  void set_pdl(bool on) { pdl_ = on; }
   cudaStream_t stream() const { return stream_; }
   int block_size(const char* name) const;
   // After the stream is synchronised: per-stage table, and its JSON form.
@@ -179,6 +181,7 @@ class Launcher {
   cudaEvent_t next_event();
   cudaStream_t stream_;
   bool profile_;
+  bool pdl_ = true;
   std::map<std::string, Stage> stages_;
   std::vector<std::string> order_;
   std::vector<cudaEvent_t> pool_;

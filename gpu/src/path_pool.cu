@@ -137,6 +137,8 @@ FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n
     if (k > 0) PB_CUDA_CHECK(cudaStreamWaitEvent(streams[k], ready[0].e, 0));
     pools[k]->begin(streams[k], total * uint64_t(k) / uint64_t(n), total * uint64_t(k + 1) / uint64_t(n) - total * uint64_t(k) / uint64_t(n), g);
   }
+  const char* pdl_env = std::getenv("PATHBENCH_GPU_POOL_PDL");  // EXPERIMENT
+  launch.set_pdl(pdl_env && *pdl_env == '1');
   std::vector<bool> going(size_t(n), true);
   for (int left = n; left > 0;) {
     for (int k = 0; k < n; ++k) {
@@ -149,6 +151,7 @@ FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n
     }
   }
   launch.set_stream(home);
+  launch.set_pdl(true);
   FrameResult r;
   for (int k = n - 1; k >= 0; --k) {  // the others first: streams[0] then waits for them
     const FrameResult p = pools[k]->finish(streams[k]);
