@@ -7,6 +7,7 @@
 #include <dlfcn.h>
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include <cctype>
@@ -142,14 +143,18 @@ DeviceInfo device_info() {
   return info;
 }
 
-uint64_t default_paths_in_flight() {
+uint64_t default_paths_in_flight(uint64_t bytes_per_path, uint64_t bytes_in_use) {
   const DeviceInfo info = device_info();
   int threads_per_sm = 0;
   PB_CUDA_CHECK(cudaDeviceGetAttribute(&threads_per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, info.device));
-  // Five full waves of threads: enough paths for every stage to fill the device
-  // (about 1.35 million on an H100); at 192 bytes a path (with light sampling) the pool
-  // takes ~260 MB, which leaves room for a 2048x2048 film under 512 MB.
-  return uint64_t(info.multiprocessors) * uint64_t(threads_per_sm) * 5;
+  const uint64_t wave = uint64_t(info.multiprocessors) * uint64_t(threads_per_sm);
+  // kWavefrontPoolWaves full waves of threads (about 2 million paths on an H100), or what
+  // kWavefrontBudgetBytes leaves beside the film and the scene (a 2048x2048 film: ~5.4
+  // waves), but never less than one wave.
+  const uint64_t waves = wave * kWavefrontPoolWaveHalves / 2;
+  const uint64_t room = bytes_in_use < kWavefrontBudgetBytes ? kWavefrontBudgetBytes - bytes_in_use : 0;
+  const uint64_t fit = bytes_per_path ? room / bytes_per_path : waves;
+  return std::max(wave, std::min(waves, fit));
 }
 
 namespace {

@@ -94,10 +94,13 @@ class PathPool {
   cudaStream_t stream_ = nullptr;
 };
 
-// Samples a wavefront frame splits among pools on streams of their own, by default: while
+// kWavefrontPools: pools a wavefront frame's samples are split among, each on a stream of its own: while
 // one pool's kernel drains (its last chunks on a few SMs), the other's fill the rest.
-// PATHBENCH_GPU_WAVEFRONT_POOLS=1..4 overrides it (a bad value: InputError).
-constexpr int kWavefrontPools = 2;
+// H100, paper-cornell 256x256x800 nee, 5 waves of paths in all, interleaved
+// (results/nvidia-h100-80gb-hbm3/wavefront-pools-52d7eea): 1 pool 15.29 ms, 2 pools 14.74,
+// 3 pools 16.30; uniform 9.32 -> 8.68; ico:8 61.9 -> 56.9. Films bit-identical (exact sums).
+// PATHBENCH_GPU_WAVEFRONT_POOLS=1..4 overrides kWavefrontPools (render.h; a bad value:
+// InputError).
 int wavefront_pools();
 
 // One frame of `total` samples over several pools, each on its own stream (streams[0] the

@@ -130,7 +130,9 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   if (settings.strategy == Strategy::Pixel) {
     pixel_counters.allocate(1, "counters", "nothing (a few bytes)");
   } else if (settings.strategy == Strategy::Wavefront) {
-    uint64_t pif = settings.paths_in_flight ? settings.paths_in_flight : default_paths_in_flight();
+    uint64_t pif = settings.paths_in_flight
+                       ? settings.paths_in_flight
+                       : default_paths_in_flight(PathPool::state_bytes(shadows), fb.bytes() + g.bytes);
     pif = std::min<uint64_t>(pif, total);
     pif = std::max<uint64_t>(pif, 1);
     if (pif > 0xFFFFFFFFull) throw InputError("--paths-in-flight: at most 4294967295 paths");

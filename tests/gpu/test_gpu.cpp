@@ -374,6 +374,33 @@ TEST(PaperQueue, RefusesWhenTheQueueDoesNotFit) {
   }
 }
 
+// The wavefront's default pool at the largest frame issue 15 names (2048 x 2048; 1 spp is
+// already 4 M samples, more than the pool holds): pool, film and scene within
+// kWavefrontBudgetBytes, and the device's peak, driver overhead included, within 512 MB;
+// at 256 x 256 the smaller film leaves the pool more. kWavefrontPools pools.
+TEST(GpuWavefrontPools, DefaultPoolStaysWithinTheBudget) {
+  PB_REQUIRE_GPU();
+  ::unsetenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
+  const Scene scene = load_scene("paper-cornell");
+  const GpuScene gs(scene);
+  uint64_t paths_2048 = 0;
+  for (uint32_t size : {2048u, 256u}) {
+    RenderSettings s = small_settings(Strategy::Wavefront, size, size == 2048 ? 1 : 64);
+    RunReport r;
+    render_gpu(scene, gs, s, &r);
+    const uint64_t pool = r.extra["pool_device_bytes"], film = r.extra["film_device_bytes"];
+    const uint64_t scene_bytes = r.extra["scene_device_bytes"];
+    std::printf("[ INFO     ] %ux%u wavefront: %llu paths in flight, pool %.1f MB + film %.1f MB + scene %.3f MB; "
+                "peak %.1f MB\n", size, size, static_cast<unsigned long long>(r.paths_in_flight), pool / 1e6,
+                film / 1e6, scene_bytes / 1e6, r.peak_device_bytes / 1e6);
+    EXPECT_EQ(r.extra["pools"], kWavefrontPools);
+    EXPECT_LE(pool + film + scene_bytes, kWavefrontBudgetBytes + 4096) << size;  // + the pools' counters
+    EXPECT_LE(r.peak_device_bytes, uint64_t(512) << 20) << size;
+    if (size == 2048) paths_2048 = r.paths_in_flight;
+    else EXPECT_GT(r.paths_in_flight, paths_2048);
+  }
+}
+
 TEST(GpuReport, HasDeviceFacts) {
   PB_REQUIRE_GPU();
   const Scene scene = load_scene("paper-cornell");

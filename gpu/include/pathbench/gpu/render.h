@@ -98,8 +98,18 @@ void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings&
 // With `keep`, the samples are added into that device film (sized for `film` on its first
 // use) and `film` is left untouched: DeviceFilm::download brings the sums back.
 
-// Default pool size of the wavefront strategy on this device.
-uint64_t default_paths_in_flight();
+// Default pool size of the wavefront strategy on this device, for paths of
+// `bytes_per_path` beside `bytes_in_use` (the film, the scene) already on the device.
+// 7.5 waves of the device's threads: with two pools (path_pool.cuh) interleaved on an H100,
+// paper-cornell 256x256x800 nee wavefront 14.74 ms at 5 waves, 13.70 at 7.5, 13.42 at 10
+// (results/nvidia-h100-80gb-hbm3/wavefront-pools-52d7eea). Capped so that pool, film and
+// scene stay within kWavefrontBudgetBytes (issue 15: at most 512 MB at any frame size;
+// the rest is headroom for what the driver's meminfo shows beside the allocations).
+constexpr uint64_t kWavefrontPoolWaveHalves = 15;
+// Pools the wavefront splits a frame's samples among (gpu/src/path_pool.cuh says why).
+constexpr int kWavefrontPools = 2;
+constexpr uint64_t kWavefrontBudgetBytes = uint64_t(448) << 20;
+uint64_t default_paths_in_flight(uint64_t bytes_per_path, uint64_t bytes_in_use);
 
 // Traversal on the device, for tests: closest hit (or any hit when `any_hit`) for each
 // ray with ray_t_min < t < t_max (watertight.h).
