@@ -148,9 +148,9 @@ uint64_t default_paths_in_flight(uint64_t bytes_per_path, uint64_t bytes_in_use)
   int threads_per_sm = 0;
   PB_CUDA_CHECK(cudaDeviceGetAttribute(&threads_per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, info.device));
   const uint64_t wave = uint64_t(info.multiprocessors) * uint64_t(threads_per_sm);
-  // kWavefrontPoolWaves full waves of threads (about 2 million paths on an H100), or what
-  // kWavefrontBudgetBytes leaves beside the film and the scene (a 2048x2048 film: ~5.4
-  // waves), but never less than one wave.
+  // 7.5 full waves of threads (about 2 million paths on an H100), or what
+  // kWavefrontBudgetBytes leaves beside the film and the scene (a 2048x2048 film: ~5.5
+  // waves; ico:8's 140 MB scene: ~5.6), but never less than one wave.
   const uint64_t waves = wave * kWavefrontPoolWaveHalves / 2;
   const uint64_t room = bytes_in_use < kWavefrontBudgetBytes ? kWavefrontBudgetBytes - bytes_in_use : 0;
   const uint64_t fit = bytes_per_path ? room / bytes_per_path : waves;
