@@ -119,9 +119,9 @@ FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene:
   return finish(stream);
 }
 
-int wavefront_pools() {
+int wavefront_pools(uint64_t total, uint64_t paths_in_flight) {
   const char* v = std::getenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
-  if (!v || !*v) return kWavefrontPools;
+  if (!v || !*v) return total > paths_in_flight ? kWavefrontPools : 1;
   const std::string_view s(v);
   if (s.size() == 1 && s[0] >= '1' && s[0] <= '4') return s[0] - '0';
   throw InputError(fmt::format("PATHBENCH_GPU_WAVEFRONT_POOLS: '{}' is not a pool count 1..4", s));

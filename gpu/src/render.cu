@@ -123,7 +123,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     throw InputError("--no-watertight: the GPU runs the Moeller-Trumbore triangle test with --strategy pixel only");
 
   // Strategy resources.
-  std::vector<std::unique_ptr<PathPool>> pools;  // wavefront: wavefront_pools() of them; paper-queue: one
+  std::vector<std::unique_ptr<PathPool>> pools;  // wavefront: wavefront_pools(...) of them; paper-queue: one
   std::vector<std::unique_ptr<ScopedStream>> pool_streams;  // the wavefront's pools beyond the first
   DeviceBuffer<PixelCounters> pixel_counters;
   uint64_t warmup_total = std::min<uint64_t>(total, pixels);
@@ -137,7 +137,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     pif = std::max<uint64_t>(pif, 1);
     if (pif > 0xFFFFFFFFull) throw InputError("--paths-in-flight: at most 4294967295 paths");
     // Under --profile one pool: each stage's events then bracket its own work alone.
-    const uint64_t n = std::min<uint64_t>(profile ? 1 : uint64_t(wavefront_pools()), pif);
+    const uint64_t n = std::min<uint64_t>(profile ? 1 : uint64_t(wavefront_pools(total, pif)), pif);
     for (uint64_t k = 0; k < n; ++k) {  // pif split as evenly as it goes
       const uint64_t cap = pif * (k + 1) / n - pif * k / n;
       pools.push_back(std::make_unique<PathPool>(cap, shadows, "the wavefront path pool", "--paths-in-flight"));
