@@ -154,6 +154,17 @@ PB_HD bool test_triangle(const BvhTriangle* tris, uint32_t i, const WatertightRa
   return true;
 }
 
+// Triangle slots [first, first + count): each tested as test_triangle does; true when an
+// any-hit query (kAnyHit) is answered. A leaf of the binary BVH or of the leaves layout.
+template <bool kAnyHit, bool kWatertight>
+PB_HD bool test_leaf_triangles(const BvhTriangle* tris, uint32_t first, uint32_t count, const WatertightRay& wr,
+                               const Vec3f& o, const Vec3f& d, float t_max, bool exact, float& t, uint32_t& hit,
+                               uint32_t& hit_slot, TraversalStats* stats) {
+  for (uint32_t i = first; i < first + count; ++i)
+    if (test_triangle<kWatertight>(tris, i, wr, o, d, t_max, exact, t, hit, hit_slot, stats) && kAnyHit) return true;
+  return false;
+}
+
 // The closest hit's answer. Woop's t ordered the candidates; the winner's t comes from
 // the plane equation in double (watertight.h), accurate on grazing rays too.
 template <bool kWatertight>
@@ -306,10 +317,8 @@ PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d
   const bool stopped = detail::walk_binary(
       bvh.nodes, o, d, t,
       [&](uint32_t first, uint32_t count) {
-        for (uint32_t i = first; i < first + count; ++i)
-          if (detail::test_triangle<kWatertight>(bvh.tris, i, wr, o, d, t_max, exact, t, hit, hit_slot, stats) && kAnyHit)
-            return true;
-        return false;
+        return detail::test_leaf_triangles<kAnyHit, kWatertight>(bvh.tris, first, count, wr, o, d, t_max, exact, t,
+                                                                 hit, hit_slot, stats);
       },
       stats);
   if (kAnyHit && stopped) {

@@ -64,7 +64,6 @@ PB_HD bool enters_leaf(const LeafBox* leaves, uint32_t i, const SlabRay& sr, flo
   return tn <= tf;
 }
 
-
 }  // namespace detail
 
 // Closest hit (kAnyHit = false) or any hit, as traverse() in bvh.h (kExact likewise).
@@ -77,10 +76,8 @@ PB_HD uint32_t traverse_leaves(const LeafListView& f, const Vec3f& o, const Vec3
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   auto test_leaf = [&](uint32_t ref) {  // true: an any-hit query is answered
-    for (uint32_t i = leaf_first(ref); i < leaf_first(ref) + leaf_count(ref); ++i)
-      if (detail::test_triangle<kWatertight>(f.tris, i, wr, o, d, t_max, exact, t, hit, hit_slot, stats) && kAnyHit)
-        return true;
-    return false;
+    return detail::test_leaf_triangles<kAnyHit, kWatertight>(f.tris, leaf_first(ref), leaf_count(ref), wr, o, d, t_max,
+                                                             exact, t, hit, hit_slot, stats);
   };
   for (uint32_t group = 0; group < f.num_leaves; group += kLeafGroup) {
     const uint32_t n = f.num_leaves - group < kLeafGroup ? f.num_leaves - group : kLeafGroup;
