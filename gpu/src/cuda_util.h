@@ -116,7 +116,42 @@ class Launcher {
   template <class... KArgs, class... Args>
   void launch(const char* name, void (*kernel)(KArgs...), uint64_t threads, Args&&... args) {
     Stage& st = stage(name, reinterpret_cast<const void*>(kernel));
-    uint64_t grid = threads == 0 ? uint64_t(st.full_wave_blocks) : (threads + st.block - 1) / st.block;
+    launch_blocks(st, name, kernel, threads == 0 ? uint64_t(st.full_wave_blocks) : (threads + st.block - 1) / st.block,
+                  std::forward<Args>(args)...);
+  }
+  // A persistent kernel (it loops over its work): one full wave, or fewer blocks where
+  // `threads`, the most its work can keep busy, is less (idle warps would still run its
+  // prologue, and claim work from a counter: work_chunks.cuh).
+  template <class... KArgs, class... Args>
+  void launch_persistent(const char* name, void (*kernel)(KArgs...), uint64_t threads, Args&&... args) {
+    Stage& st = stage(name, reinterpret_cast<const void*>(kernel));
+    const uint64_t wave = uint64_t(st.full_wave_blocks) * uint64_t(st.block);
+    const bool fewer = threads != 0 && threads < wave;  // 0: a full wave, as launch() takes it
+    launch_blocks(st, name, kernel, fewer ? (threads + st.block - 1) / st.block : uint64_t(st.full_wave_blocks),
+                  std::forward<Args>(args)...);
+  }
+  // The stream later launches go to (the wavefront's pools take turns on theirs: run_pools).
+  void set_stream(cudaStream_t stream) { stream_ = stream; }
+  // Whether launches may start before the previous kernel of their stream ends (PDL, below).
+  void set_pdl(bool on) { pdl_ = on; }
+  cudaStream_t stream() const { return stream_; }
+  int block_size(const char* name) const;
+  // After the stream is synchronised: per-stage table, and its JSON form.
+  nlohmann::json collect();
+  static std::string format_table(const nlohmann::json& profile);
+  void clear();  // forget counts and times (after a warm-up)
+
+ private:
+  struct Stage {
+    const void* kernel = nullptr;
+    int block = 256;
+    int full_wave_blocks = 1;
+    uint64_t launches = 0;
+    std::vector<std::pair<cudaEvent_t, cudaEvent_t>> events;
+  };
+  // `grid` blocks of the stage's size on the current stream.
+  template <class... KArgs, class... Args>
+  void launch_blocks(Stage& st, const char* name, void (*kernel)(KArgs...), uint64_t grid, Args&&... args) {
     if (grid == 0) return;
     if (grid > 0x7FFFFFFFull) grid = 0x7FFFFFFFull;  // kernels loop (grid stride)
     cudaEvent_t ev[2] = {nullptr, nullptr};
@@ -149,34 +184,6 @@ class Launcher {
       st.events.push_back({ev[0], ev[1]});
     }
   }
-  // A persistent kernel (it loops over its work): one full wave, or fewer blocks where
-  // `threads`, the most its work can keep busy, is less (idle warps would still run its
-  // prologue, and claim work from a counter: work_chunks.cuh).
-  template <class... KArgs, class... Args>
-  void launch_persistent(const char* name, void (*kernel)(KArgs...), uint64_t threads, Args&&... args) {
-    const Stage& st = stage(name, reinterpret_cast<const void*>(kernel));
-    const uint64_t wave = uint64_t(st.full_wave_blocks) * uint64_t(st.block);
-    launch(name, kernel, threads < wave ? threads : 0, std::forward<Args>(args)...);
-  }
-  // The stream later launches go to (the wavefront's pools take turns on theirs: run_pools).
-  void set_stream(cudaStream_t stream) { stream_ = stream; }
-  // Whether launches may start before the previous kernel of their stream ends (PDL, above).
-  void set_pdl(bool on) { pdl_ = on; }
-  cudaStream_t stream() const { return stream_; }
-  int block_size(const char* name) const;
-  // After the stream is synchronised: per-stage table, and its JSON form.
-  nlohmann::json collect();
-  static std::string format_table(const nlohmann::json& profile);
-  void clear();  // forget counts and times (after a warm-up)
-
- private:
-  struct Stage {
-    const void* kernel = nullptr;
-    int block = 256;
-    int full_wave_blocks = 1;
-    uint64_t launches = 0;
-    std::vector<std::pair<cudaEvent_t, cudaEvent_t>> events;
-  };
   Stage& stage(const char* name, const void* kernel);
   cudaEvent_t next_event();
   cudaStream_t stream_;

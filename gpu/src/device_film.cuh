@@ -8,12 +8,11 @@
 #include <cstdint>
 
 #include "cuda_util.h"
+#include "kernel_sync.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/math.h"
 
 namespace pb::gpu {
-
-constexpr unsigned kFullMask = 0xFFFFFFFFu;
 
 // The film as the kernels see it: the one device view of a Film (its sums, counts and
 // variance sums on the device, its scale and sample limit).

@@ -10,6 +10,8 @@
 
 namespace pb::gpu {
 
+constexpr unsigned kFullMask = 0xFFFFFFFFu;  // every lane of a warp (__shfl_sync, __reduce_add_sync)
+
 __device__ __forceinline__ void pdl_trigger() {
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
   asm volatile("griddepcontrol.launch_dependents;" ::: "memory");

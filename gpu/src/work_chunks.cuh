@@ -27,14 +27,14 @@ __device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* co
   const Index warp = grid_thread() >> 5, warps = grid_threads() >> 5;
   const bool leader = (threadIdx.x & 31) == 0;
   Index claim = warp < fixed || !leader ? Index(0) : atomicAdd(counter, Index(1));
-  Index k = warp < fixed ? warp : fixed + __shfl_sync(0xFFFFFFFFu, claim, 0);
+  Index k = warp < fixed ? warp : fixed + __shfl_sync(kFullMask, claim, 0);
   while (k < end) {  // one call site of body: inlined once
     // The next chunk is the static one after k, or a claim made now, before working on k,
     // so that the atomic's latency hides behind the work.
     const bool claims = k + warps >= fixed;
     if (claims && leader) claim = atomicAdd(counter, Index(1));
     body(k);
-    k = claims ? fixed + __shfl_sync(0xFFFFFFFFu, claim, 0) : k + warps;
+    k = claims ? fixed + __shfl_sync(kFullMask, claim, 0) : k + warps;
   }
 }
 
