@@ -83,6 +83,13 @@ if has sanitize; then
       echo "rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' $OUT/logs/sanitizer-$tool-$st.txt)" | tee -a "$OUT/summary.txt"
     done
   done
+  # Whole warps of one pixel (spp a multiple of 32: the film add by REDUX, device_film.cuh).
+  for st in pixel wavefront; do
+    log "compute-sanitizer memcheck $st, 64 spp"
+    timeout 120 compute-sanitizer --tool memcheck --print-limit 20 $PB render ${small/--spp 4/--spp 64} --strategy $st \
+      --paths-in-flight 1000 > "$OUT/logs/sanitizer-memcheck-spp64-$st.txt" 2>&1
+    echo "rc=$? $(grep -E 'ERROR SUMMARY' $OUT/logs/sanitizer-memcheck-spp64-$st.txt)" | tee -a "$OUT/summary.txt"
+  done
 fi
 
 if has bench; then

@@ -39,13 +39,8 @@ rm -rf $base && mkdir -p $base && tar --exclude=./build-gpu --exclude=./build --
 OUT=$out bash gpu/run_on_device.sh build test sanitize > "$out/run_on_device.txt" 2>&1
 echo "build + test + sanitize rc=$?"
 wait
-grep -E "ctest|passed|ERROR SUMMARY|hazard|PaperFrameWithinAcceptance" "$out/summary.txt" | head -20
+grep -E "ctest|passed|ERROR SUMMARY|hazard|PaperFrameWithinAcceptance" "$out/summary.txt" | head -24
 PB=build-gpu/bin/pathbench
-for st in pixel wavefront; do  # whole warps of one pixel (spp a multiple of 32)
-  timeout 120 compute-sanitizer --tool memcheck $PB render --device gpu --quiet --scene paper-cornell --width 32 --height 32 \
-    --spp 64 --bounces 2 --sampling nee --strategy $st --paths-in-flight 1000 > "$out/memcheck-spp64-$st.txt" 2>&1
-  echo "memcheck spp 64 $st: rc=$? $(grep 'ERROR SUMMARY' "$out/memcheck-spp64-$st.txt")"
-done
 for what in paper raycast; do
   filter=render/gpu; [ $what = raycast ] && filter=raycast/gpu
   timeout 200 build-gpu/bin/pathbench-bench --preset paper --benchmark_filter=$filter --benchmark_repetitions=5 \
