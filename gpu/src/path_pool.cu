@@ -1,7 +1,8 @@
 // The wavefront and paper-queue strategies' frame loop: trace (plans the iteration,
 // traces the last iteration's shadow rays and this one's closest hits) and shade launched
-// in turn on one stream (no host wait between them); whether the frame is done is read
-// from mapped host memory the trace kernels write.
+// in turn on a pool's stream (no host wait between them), the pools of a frame taking
+// turns (run_pools); whether a pool is done is read from mapped host memory its trace
+// kernels write.
 #include "path_pool.cuh"
 
 #include <fmt/core.h>
@@ -110,15 +111,6 @@ FrameResult PathPool::finish(cudaStream_t stream) {
   return r;
 }
 
-FrameResult PathPool::run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
-                          uint64_t total, FilmDev film, bool variance) {
-  begin(stream, 0, total, g);
-  launch.set_stream(stream);
-  while (step(launch, g, c, spp, film, variance)) {
-  }
-  return finish(stream);
-}
-
 int wavefront_pools(uint64_t total, uint64_t paths_in_flight) {
   const char* v = std::getenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
   if (!v || !*v) return total > paths_in_flight ? kWavefrontPools : 1;
@@ -131,8 +123,10 @@ FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n
                       const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, uint64_t total, FilmDev film,
                       bool variance) {
   const cudaStream_t home = launch.stream();
-  std::vector<ScopedEvent> ready(static_cast<size_t>(n));  // streams[k] past its work: the others start, or streams[0] ends, after it
-  PB_CUDA_CHECK(cudaEventRecord(ready[0].e, streams[0]));
+  // streams[k] past its work: the others start, or streams[0] ends, after it (one pool
+  // needs none: nothing is made between the frame's start event and its first launch).
+  std::vector<ScopedEvent> ready(n > 1 ? static_cast<size_t>(n) : 0);
+  if (n > 1) PB_CUDA_CHECK(cudaEventRecord(ready[0].e, streams[0]));
   for (int k = 0; k < n; ++k) {
     if (k > 0) PB_CUDA_CHECK(cudaStreamWaitEvent(streams[k], ready[0].e, 0));
     pools[k]->begin(streams[k], total * uint64_t(k) / uint64_t(n), total * uint64_t(k + 1) / uint64_t(n) - total * uint64_t(k) / uint64_t(n), g);

@@ -50,14 +50,11 @@ class PathPool {
            (shadows.pairs ? sizeof(float4) + sizeof(float2) : 0);
   }
 
-  // One frame of `total` samples: stages launched until every path has ended.
-  FrameResult run(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
-                  uint64_t total, FilmDev film, bool variance);
-
-  // run() in steps, for pools that share a frame (run_pools): begin() readies the pool for
-  // the frame's samples [first, first + count) on `stream`; step() launches one iteration
-  // (trace, shade) on the launcher's stream and returns false once the host has seen an
-  // iteration with nothing to trace; finish() waits for the stream and returns the result.
+  // A frame in steps (run_pools drives them, for one pool or several that share a frame):
+  // begin() readies the pool for the frame's samples [first, first + count) on `stream`;
+  // step() launches one iteration (trace, shade) on the launcher's stream and returns false
+  // once the host has seen an iteration with nothing to trace; finish() waits for the
+  // stream and returns the result.
   void begin(cudaStream_t stream, uint64_t first, uint64_t count, const GpuScene::Impl& g);
   bool step(Launcher& launch, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, FilmDev film, bool variance);
   FrameResult finish(cudaStream_t stream);
@@ -106,10 +103,11 @@ class PathPool {
 // overrides it (a bad value: InputError).
 int wavefront_pools(uint64_t total, uint64_t paths_in_flight);
 
-// One frame of `total` samples over several pools, each on its own stream (streams[0] the
-// frame's: the others start after what it holds and it ends after them), their iterations
-// launched in turn; `total` split into contiguous ranges. Stats summed, iterations the most
-// any pool took, paths in flight and pool bytes summed.
+// One frame of `total` samples, stages launched until every path has ended, over one pool
+// or several, each on its own stream (streams[0] the frame's: the others start after what it
+// holds and it ends after them), their iterations launched in turn; `total` split into
+// contiguous ranges. Stats summed, iterations the most any pool took, paths in flight and
+// pool bytes summed.
 FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n, Launcher& launch,
                       const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, uint64_t total, FilmDev film,
                       bool variance);

@@ -161,16 +161,16 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   }
 
   const PixelOccupancy occupancy = settings.strategy == Strategy::Pixel ? pixel_occupancy(g) : PixelOccupancy{};
+  std::vector<PathPool*> pool_ptrs;
+  std::vector<cudaStream_t> pool_stream_ids{stream.s};  // pool k's stream: the render's, then pool_streams
+  for (const auto& pool : pools) pool_ptrs.push_back(pool.get());
+  for (const auto& ps : pool_streams) pool_stream_ids.push_back(ps->s);
   auto run_frame = [&](uint64_t n) {
     if (settings.strategy == Strategy::Pixel)
       return run_pixel(launch, stream.s, g, config, spp, n, fb.view, film.has_variance(), settings.precision,
                        settings.watertight, pixel_counters, occupancy.min_blocks);
-    if (pools.size() == 1) return pools[0]->run(launch, stream.s, g, config, spp, n, fb.view, film.has_variance());
-    std::vector<PathPool*> p;
-    std::vector<cudaStream_t> s{stream.s};
-    for (const auto& pool : pools) p.push_back(pool.get());
-    for (const auto& ps : pool_streams) s.push_back(ps->s);
-    return run_pools(p.data(), s.data(), int(p.size()), launch, g, config, spp, n, fb.view, film.has_variance());
+    return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, spp, n, fb.view,
+                     film.has_variance());
   };
 
   // Warm-up (module load, first-touch of every buffer), then the timed frame. A kept
