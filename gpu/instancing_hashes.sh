@@ -2,7 +2,7 @@
 # --instancing on the GPU (issue 16 item 2): for each instanced test scene, strategy and
 # device, the film hash with --instancing off and on (the report's film_hash), and whether
 # they match. The GPU's must match everywhere (two_level_bvh.h); the CPU's match but for
-# rare rays meeting a copy's edge (cpu/NOTES.md). Prints "device strategy scene off on same|DIFF"
+# rare rays meeting a copy's edge (docs/notes/cpu-log.md). Prints "device strategy scene off on same|DIFF"
 # and exits 1 if a GPU line differs.
 # Usage: gpu/instancing_hashes.sh [build-dir] [WxHxSPP]   (needs a CUDA build and a GPU)
 set -euo pipefail

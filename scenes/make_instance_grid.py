@@ -8,7 +8,7 @@ flips the flat copy's winding), over a floor under an area light.
 writes OUT_DIR/ico<subdiv>.obj and OUT_DIR/grid-<n^3>.json. Deterministic for a seed.
 tests/data/scenes/instances/ holds the 5^3 = 125 copy scene of the instancing identity tests
 (tests/unit/test_instancing.cpp); --n 10 --subdiv 3 is the 1000-copy scene whose BVH sizes
-cpu/NOTES.md and gpu/NOTES.md give.
+docs/notes/cpu-log.md and docs/notes/gpu-log.md give.
 """
 import argparse
 import json

@@ -14,7 +14,7 @@ and a strategy's share is its rays/s over that. The pixel strategy is compared w
 Embree's single-ray calls (rtcIntersect1 / rtcOccluded1), the wavefront with its packet
 calls (the benchmarks' 16-wide ones: the wavefront's own width with `--isa avx512`; its
 8-wide packets with avx2 or scalar ran the same kernel on an AVX2 host's Embree,
-notes/cpu-performance.md).
+docs/notes/cpu-log.md).
 
 Run on its own, it sets render reports against the raw rates, one line per report with
 the instruction set its path step ran (`--isa`, the report's `isa`) and the CPU's flags:

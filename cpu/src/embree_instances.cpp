@@ -6,7 +6,7 @@
 // triangle geometry. Embree then names a triangle; the path step recomputes the hit on
 // the flat, world-space triangle (surface_hit), so shading
 // sees exactly the flat scene's triangles. Whether Embree names the same triangle as
-// in the flat scene is tested, not assumed (tests/unit/test_instancing.cpp, cpu/NOTES.md).
+// in the flat scene is tested, not assumed (tests/unit/test_instancing.cpp, docs/notes/cpu-log.md).
 #include <fmt/core.h>
 
 #include <algorithm>

@@ -31,7 +31,7 @@ std::unique_ptr<EmbreeScene> make_embree_scene(const Scene& s, bool watertight, 
                                                Instancing instancing) {
   // Only when asked: Embree tests a copy's triangles in the prototype's coordinates, so at
   // a copy's edges it may name another triangle than the flat scene does (rarely: 2
-  // pixels of 30,000 in the worst test scene; cpu/NOTES.md). `auto` keeps the CPU's image
+  // pixels of 30,000 in the worst test scene; docs/notes/cpu-log.md). `auto` keeps the CPU's image
   // the flat one bit for bit; the GPU's two-level BVH is exact and is used under auto.
   if (instancing == Instancing::On && use_instancing(instancing, s.instances.size())) {
     if (layout == EmbreeLayout::Quads && instancing == Instancing::On)

@@ -2,7 +2,7 @@
 // One wavefront slice's additions to the shared film, combined while they hit one pixel.
 // Film::add_atomic costs four locked read-modify-writes a path (three sums and the
 // count), which at ~10 cycles each are a large part of the wavefront's own time on the
-// CPU (cpu/NOTES.md, "SoA hand-over"); the wavefront hands out the samples of one
+// CPU (docs/notes/cpu-log.md, "SoA hand-over"); the wavefront hands out the samples of one
 // pixel together (SampleSource), so its paths mostly end next to others of the same
 // pixel. Their quantised values are summed here in plain integers and added to the film
 // once per run of one pixel. The sums are integers, so the film holds the same bits

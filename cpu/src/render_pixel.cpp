@@ -6,7 +6,7 @@
 // diffuse-only float renders with a vector ISA (--isa) up to 16 (AVX-512) or 8 (AVX2)
 // samples of a pixel run together, a vector wide, their rays as one packet
 // (trace_samples_batched; single rays there measured 8.8% more instructions:
-// notes/cpu-performance.md), bit-identical to trace_path.
+// docs/notes/cpu-log.md), bit-identical to trace_path.
 #include <tbb/blocked_range2d.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>

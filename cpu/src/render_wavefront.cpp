@@ -8,9 +8,9 @@
 // The pass is one loop, not a stage per list: a packet's hits go straight into the
 // shading batch, shading routes each path at once (on in `live`, compacted in place; to
 // `final`; ended: to the film and `free`), so no list is rebuilt and no path is looked
-// at twice per round (cpu/NOTES.md, "Item 5, queue management"). With the batched path
+// at twice per round (docs/notes/cpu-log.md, "Item 5, queue management"). With the batched path
 // step the kernel routes, writing the next rays where the next packet reads them
-// (PoolSlice::ray, PendingShadows; cpu/NOTES.md, "SoA hand-over"). Per path the order
+// (PoolSlice::ray, PendingShadows; docs/notes/cpu-log.md, "SoA hand-over"). Per path the order
 // stays the path step's: a vertex's shadow ray is answered before the path's next
 // vertex is shaded (every pending shadow packet is traced by the end of the pass).
 // The film sums are integers, so the order in which paths reach it does not matter.

@@ -23,7 +23,7 @@ constexpr int kMaxShadeLanes = 16;
 // Where the shading kernel appends the lanes of one kind (ShadeBatch::next, ::final,
 // ::shadow), packed in lane order, as structures of arrays: the rays land where the next
 // packet is traced from (an Embree packet's org/dir arrays, or the wavefront's live
-// rays), with no per-lane loop and no transpose (cpu/NOTES.md, "SoA hand-over").
+// rays), with no per-lane loop and no transpose (docs/notes/cpu-log.md, "SoA hand-over").
 struct ShadeStream {
   float* ray[6];           // org x, y, z, dir x, y, z (unused by the final stream)
   float* contribution[3];  // the shadow stream's: added to L where the ray is unoccluded

@@ -1,6 +1,6 @@
 #pragma once
 // Tiny scenes ("model only what a scene requires"): for a scene of a few dozen triangles
-// Embree's robust traversal costs ~600 instructions per closest-hit ray (cpu/NOTES.md),
+// Embree's robust traversal costs ~600 instructions per closest-hit ray (docs/notes/cpu-log.md),
 // while testing every triangle against a packet of rays, lanes = rays, costs a fraction
 // of that. TinyScene is the table such a test reads (the triangles in the vertex order
 // Embree's own Pluecker test sees them, so the arithmetic is Embree's); the test itself
@@ -13,7 +13,7 @@
 // distance is within a small relative margin of another candidate's (ties), of the ray's
 // tfar, or of its origin (the surface the ray leaves from), where Embree's rounding could
 // decide either way. The margins are far above the float error of Embree's formulas and
-// of ours (cpu/NOTES.md gives the bounds), so a proven answer is Embree's answer.
+// of ours (docs/notes/cpu-log.md gives the bounds), so a proven answer is Embree's answer.
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -32,7 +32,7 @@ namespace pb::cpu {
 struct TinyScene {
   // Above 3 triangles per lane (as Embree sees them: 24 with AVX2, 48 with AVX-512)
   // Embree's BVH is cheaper than testing them all (AVX2 measured between 14 and 34
-  // triangles; AVX-512, whose test costs half per ray, estimated: cpu/NOTES.md).
+  // triangles; AVX-512, whose test costs half per ray, estimated: docs/notes/cpu-log.md).
   static constexpr int kTrianglesPerLane = 3;
   struct alignas(64) Triangle {
     float p[9];         // vertices v0, v1, v2 in Embree's order

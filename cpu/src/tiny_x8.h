@@ -23,7 +23,7 @@
 // on |vertex - origin| over the scene), T's band 2^-20 |v0|_inf (|Ng|_1 + 3 E^2), den's
 // 2^-20 |Ng|_1 |D|_1, t's error (band + t den band) / |den| + 2^-20 t (Embree's rcp).
 // tnear is the rays' (embree_rays.h: watertight.h's ray_t_min, a few ulps of the origin),
-// compared in T as tfar is. cpu/NOTES.md gives the argument.
+// compared in T as tfar is. docs/notes/cpu-log.md gives the argument.
 namespace pb::cpu::PB_SIMD_NS {
 
 #if PB_SIMD_LANES == 16
@@ -53,7 +53,7 @@ inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
 // The plane cull: a segment [0, t_end] whose both ends lie on one side of the triangle's
 // plane by more than the margin never reaches it, in Embree's arithmetic too (the margin,
 // 2^-15 of `scale` and more for slivers, is >= 16x the float error of this test plus
-// Embree's T, den and its normal's rounding: cpu/NOTES.md). Far cheaper than the depth or
+// Embree's T, den and its normal's rounding: docs/notes/cpu-log.md). Far cheaper than the depth or
 // the edges for the walls of a closed box, which every shadow segment, and every segment
 // up to a found hit, misses.
 inline IV plane_away(const TinyScene::Triangle& tr, V3 o, V3 d, FV t_end, FV scale) {

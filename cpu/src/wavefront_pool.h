@@ -21,7 +21,7 @@ namespace {
 // started together are then samples of one pixel and its neighbours (coherent camera
 // rays, as the pixel strategy's packets), and paths that end together add to one film
 // pixel, whose sums stay in cache (pixel-fastest order touched every film line once per
-// pass over the image: a miss, under a locked add, per path; cpu/NOTES.md). The order
+// pass over the image: a miss, under a locked add, per path; docs/notes/cpu-log.md). The order
 // cannot change the image: each path's numbers come from its (pixel, sample) alone, and
 // the film's sums are integers. Pixels [first_pixel, first_pixel + pixels), each with
 // samples [first_sample, first_sample + spp).

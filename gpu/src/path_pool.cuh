@@ -94,12 +94,12 @@ class PathPool {
 // kWavefrontPools: pools a wavefront frame's samples are split among, each on a stream of its own: while
 // one pool's kernel drains (its last chunks on a few SMs), the other's fill the rest.
 // H100, paper-cornell 256x256x800 nee, 5 waves of paths in all, interleaved
-// (results/nvidia-h100-80gb-hbm3/wavefront-pools-52d7eea): 1 pool 15.29 ms, 2 pools 14.74,
+// (results/nvidia-h100-80gb-hbm3/archive/wavefront-pools-52d7eea): 1 pool 15.29 ms, 2 pools 14.74,
 // 3 pools 16.30; uniform 9.32 -> 8.68; ico:8 61.9 -> 56.9. Films bit-identical (exact sums).
 // A frame of `total` samples that the pool holds at once (total <= paths_in_flight) has no
 // refills whose kernels could overlap: one pool, whose kernels PDL chains with no launch gap
 // (two made 32x32x16 and 128x128x4 wavefront frames 0.07 -> 0.12 ms on an H100:
-// results/nvidia-h100-80gb-hbm3/record-cd791c9). PATHBENCH_GPU_WAVEFRONT_POOLS=1..4
+// results/nvidia-h100-80gb-hbm3/archive/record-cd791c9). PATHBENCH_GPU_WAVEFRONT_POOLS=1..4
 // overrides it (a bad value: InputError).
 int wavefront_pools(uint64_t total, uint64_t paths_in_flight);
 

@@ -45,7 +45,7 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
 
 // kMinBlocks: blocks of 256 an SM must fit, registers capped to match (1: the compiler's
 // choice, 91 registers and 2 blocks for the float watertight kernel). Measured on an H100
-// (gpu/NOTES.md, "Occupancy of the megakernel"): 3 blocks suit scenes whose BVH sits in
+// (docs/notes/gpu-log.md, "Occupancy of the megakernel"): 3 blocks suit scenes whose BVH sits in
 // L1 (issue bound), kPixelLatencyBlocks (8: 32 registers, spills) scenes that miss to L2
 // (latency bound).
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks>

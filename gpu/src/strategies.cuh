@@ -48,14 +48,14 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // The latency-bound build: 8 blocks (32 registers, ~700 bytes of spills) since the slab
 // test's min/max became one instruction each; interleaved on an H200 against 5 blocks
 // (48 registers): ico:5 35.81 -> 35.69 ms, ico:7 43.12 -> 42.92, ico:8 49.08 -> 47.96
-// (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/pixel-occupancy-8).
+// (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/archive/pixel-occupancy-8).
 constexpr int kPixelLatencyBlocks = 8;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from
 // a counter (work_chunks.cuh): more where traversals diverge (from kPixelLatencyBoundTris
 // triangle references on), where static shares end most unevenly. H100, interleaved
-// (results/nvidia-h100-80gb-hbm3/work-chunks): paper-cornell 1 round 15.63 ms, 4 rounds
+// (results/nvidia-h100-80gb-hbm3/archive/work-chunks): paper-cornell 1 round 15.63 ms, 4 rounds
 // 16.15; ico:8 (100 spp) 1 round 8.30, 4 rounds 7.70 (grid stride alone: 8.87).
 constexpr uint32_t kWavefrontCounterRounds = 1, kWavefrontCounterRoundsLatencyBound = 4;
 

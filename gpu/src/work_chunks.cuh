@@ -4,7 +4,7 @@
 // first `fixed` chunks go by grid stride (warp w takes w, w + W, ...: no atomics); the rest
 // come from a counter, one atomic a chunk, so a warp that drew short work takes more and a
 // launch ends when its work does, not with the warp of the longest static share.
-// Measured on an H100 (gpu/NOTES.md, "Work from a counter"): the megakernel all from the
+// Measured on an H100 (docs/notes/gpu-log.md, "Work from a counter"): the megakernel all from the
 // counter, paper-cornell 12.00 -> 11.58 ms, ico:8 48.6 -> 43.0; the wavefront's stages
 // with the last full round and the partial one from it, paper-cornell unchanged, ico:8 -6 %;
 // with the last 4, ico:8 -14 %, paper-cornell +3.5 % (strategies.cuh, kWavefrontCounterRounds).

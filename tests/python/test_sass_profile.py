@@ -91,7 +91,7 @@ def test_refuses_bad_options(profile):
 
 
 def test_gzipped_profile_of_record():
-    p = ROOT / "results/nvidia-h200/sass-profile-97ba504/pixel-sass.csv.gz"
+    p = ROOT / "results/nvidia-h200/archive/sass-profile-97ba504/pixel-sass.csv.gz"
     ins = sass_profile.read_instructions(p)
     assert len(ins) == 3672
     total = sum(i.executed for i in ins)

@@ -2,7 +2,7 @@
 // prototypes, hits mapped back to the flat triangles. The films equal the flat scene's on
 // the instanced test scenes (pixel and wavefront, AVX2 and AVX-512 where present, 1 and
 // 2 threads); ray by ray Embree's instanced answer can differ from its flat one only on
-// rays grazing an edge (object-space rounding: cpu/NOTES.md), which is measured here.
+// rays grazing an edge (object-space rounding: docs/notes/cpu-log.md), which is measured here.
 // The option's parsing and what it does where it cannot apply are tested too.
 #include <gtest/gtest.h>
 

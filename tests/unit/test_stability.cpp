@@ -213,7 +213,7 @@ TEST(Watertight, RaysAtEdgesAndVerticesOfTheClosedBoxAllHit) {
 // rays aimed exactly at points of its edges and at its vertices must hit at or before
 // the edge (some triangle of it, or of another one in front). Embree's triangle4 layout
 // in robust mode (vertex plus stored edges) let 719 of these 2.4 M rays through, its
-// default triangle4v none (notes/cpu-performance.md).
+// default triangle4v none (docs/notes/cpu-log.md).
 Scene random_icosahedra(uint32_t count, std::mt19937& rng) {
   Scene s = make_paper_cornell();
   const float g = (1.0f + std::sqrt(5.0f)) / 2.0f;

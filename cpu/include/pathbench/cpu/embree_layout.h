@@ -1,7 +1,7 @@
 #pragma once
 // EmbreeLayout::Auto: which layout (settings.h) Embree traces a scene faster with. In
 // robust mode the answer depends on the scene -- paired into quads, paper-cornell took
-// 22% fewer instructions per sample and cornell-box 21% more (notes/cpu-performance.md)
+// 22% fewer instructions per sample and cornell-box 21% more (docs/notes/cpu-log.md)
 // -- so it is measured, not guessed: both layouts trace the same probe rays (camera rays,
 // rays leaving random surface points, shadow rays to the emitters), in alternating
 // rounds, and quads are kept only when clearly faster. The answer is remembered per scene

@@ -1,7 +1,7 @@
 #pragma once
 // Triangles that share an edge, paired into Embree quads. In robust mode Embree tests a
 // quad's two triangles in one go, and a closed box made of quads is traced with about a
-// third fewer instructions per ray than the same triangles (notes/cpu-performance.md).
+// third fewer instructions per ray than the same triangles (docs/notes/cpu-log.md).
 // The pairing changes no geometry: each quad is exactly two of the scene's triangles,
 // with their own vertices; hits are mapped back to the scene's triangle ids.
 #include <array>

@@ -119,7 +119,7 @@ PB_HD float safe_inverse(float d) {
 // whose computed t is <= the best t is then computed in full and compared, and the
 // answer depends on the triangles alone, not on the order they come in. Without it (a
 // scene without instances) a triangle is tested against the best t and wins if it hits,
-// as before instancing existed, so those scenes keep their images (gpu/NOTES.md).
+// as before instancing existed, so those scenes keep their images (docs/notes/gpu-log.md).
 constexpr float kTieSlack = 1.0f + 0x1p-20f;
 PB_HD bool closer(float tt, uint32_t prim, float t, uint32_t hit) { return tt < t || (tt == t && prim < hit); }
 
@@ -306,7 +306,7 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
 // kExact: the view's exact_ties read at run time (-1), or known at compile time (0, 1):
 // the hot kernels are compiled for one or the other, since a run-time flag keeps the tie
 // compare's registers live in every kernel (ptxas, sm_90, k_pixel: 48 -> 60 bytes of
-// spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (gpu/NOTES.md).
+// spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (docs/notes/gpu-log.md).
 template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
 PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {

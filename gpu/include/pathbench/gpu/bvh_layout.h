@@ -29,7 +29,7 @@ namespace pb::gpu {
 
 enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6 };
 
-// Measured on an H100 (results/nvidia-h100-80gb-hbm3/layouts-a12fc4c, interleaved,
+// Measured on an H100 (results/nvidia-h100-80gb-hbm3/archive/layouts-a12fc4c, interleaved,
 // CUDA events; before the leaves layout existed): the binary BVH is the fastest everywhere we measured — paper-cornell
 // 256x256x800 pixel 13.7 ms (wide8 19.7, wide4 38.2, brute 18.4), wavefront 19.2 ms
 // (wide8 21.5, brute 25.5); ico:8 pixel 75.8 ms (wide8 114.2, wide4 147.3); brute force
@@ -38,7 +38,7 @@ constexpr GpuBvhLayout kAutoLayout = GpuBvhLayout::Binary;
 constexpr uint32_t kDefaultBruteMaxTriangles = 0;
 constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute force is never the answer
 // auto's leaves layout: up to this many triangles (a scene without instances). Measured on
-// an H100 at 597d689 (results/nvidia-h100-80gb-hbm3/leaves-597d689, 256x256x800 nee pixel,
+// an H100 at 597d689 (results/nvidia-h100-80gb-hbm3/archive/leaves-597d689, 256x256x800 nee pixel,
 // interleaved): paper-cornell (14 triangles, 7 leaves) 11.54 -> 11.34 ms, wavefront 15.60
 // -> 15.29; paper-cornell-ico:0 (34) 20.63 -> 20.57; ico:1 (94) 23.49 -> 32.30: every box is
 // tested for every ray, so it pays only while the leaves are few.

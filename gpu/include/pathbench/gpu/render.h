@@ -102,7 +102,7 @@ void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings&
 // `bytes_per_path` beside `bytes_in_use` (the film, the scene) already on the device.
 // 7.5 waves of the device's threads: with two pools (path_pool.cuh) interleaved on an H100,
 // paper-cornell 256x256x800 nee wavefront 14.74 ms at 5 waves, 13.70 at 7.5, 13.42 at 10
-// (results/nvidia-h100-80gb-hbm3/wavefront-pools-52d7eea). Capped so that pool, film and
+// (results/nvidia-h100-80gb-hbm3/archive/wavefront-pools-52d7eea). Capped so that pool, film and
 // scene stay within kWavefrontBudgetBytes: issue 15 asks for at most 512 MB at any frame
 // size, and beside the allocations the driver's meminfo grew by 53 MB (2048x2048
 // paper-cornell) to 58 MB (ico:8) with two pools running (24-29 MB with one: local memory
