@@ -14,6 +14,8 @@
 #include "accuracy_reference.h"
 #include "pathbench/run/world.h"
 #include "cli_checks.h"
+#include "output_dirs.h"
+#include "python_tools.h"
 #include "pathbench/analysis/accuracy_metrics.h"
 #include "pathbench/common/output_file.h"
 #include "pathbench/common/errors.h"
@@ -23,9 +25,6 @@
 #include "pathbench/run/run.h"
 #include "pathbench/run/run_context.h"
 
-#ifndef PATHBENCH_SOURCE_DIR
-#define PATHBENCH_SOURCE_DIR "."
-#endif
 
 namespace pb::app {
 
@@ -133,15 +132,13 @@ void validate(const AccuracyOptions& o) {
   if (o.threads < 0) throw InputError("--threads: must be >= 0 (0 = all)");
 }
 
-// tools/accuracy_report.py through the project's .venv (found from the source tree).
+// tools/accuracy_report.py through the one Python launcher.
 enum class ToolRun { Done, Failed, Unavailable };
 ToolRun run_report_tool(const std::string& json_path, std::string& command) {
-  const fs::path src(PATHBENCH_SOURCE_DIR);
-  const fs::path python = src / ".venv" / "bin" / "python";
-  const fs::path tool = src / "tools" / "accuracy_report.py";
-  command = fmt::format("'{}' '{}' '{}'", python.string(), tool.string(), json_path);
-  if (!fs::exists(python) || !fs::exists(tool)) return ToolRun::Unavailable;
-  return std::system(command.c_str()) == 0 ? ToolRun::Done : ToolRun::Failed;
+  command = fmt::format("{} {}/accuracy_report.py '{}'", find_python(), find_python_tools(), json_path);
+  if (find_python_tools().empty()) return ToolRun::Unavailable;
+  const int status = run_python_tool({"accuracy", "accuracy_report.py", {"numpy", "matplotlib"}}, {json_path}, true);
+  return status == 0 ? ToolRun::Done : status == kPythonToolMissing ? ToolRun::Unavailable : ToolRun::Failed;
 }
 
 }  // namespace
@@ -159,7 +156,9 @@ void add_accuracy_options(CLI::App& cmd, AccuracyOptions& o) {
                  "a configuration's ladder stops before a render expected to take longer than this")
       ->capture_default_str();
   cmd.add_option("--configs", o.configs, "comma-separated configuration names (default: all)");
-  cmd.add_option("--out-dir", o.out_dir, "output folder (default results/<machine>/accuracy; the reference is cached there)");
+  cmd.add_option("--out-dir", o.out_dir, "output folder (default pathbench-out/<machine>/accuracy; the reference is cached there)");
+  cmd.add_flag("--update-committed", o.update_committed,
+               "maintainers: write into the committed results/<machine>/accuracy/ instead of pathbench-out/");
   cmd.add_option("--seed", o.seed, "random seed of the sweep renders")->check(non_negative())->capture_default_str();
   cmd.add_option("--threads", o.threads, "CPU threads (0: all)")->capture_default_str();
   cmd.add_flag("--quick", o.quick, "smoke test: 32x32, reference 256 spp, ladder up to 16 spp (unless given)");
@@ -185,7 +184,7 @@ int run_accuracy(AccuracyOptions& o) {
     if (!run::gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
   }
   const Scene scene = load_scene(o.scene);
-  const std::string dir = o.out_dir.empty() ? "results/" + run::machine_folder(base.device) + "/accuracy" : o.out_dir;
+  const std::string dir = output_dir(o.out_dir, o.update_committed, run::machine_folder(base.device), "accuracy");
   const std::string stem = fmt::format("{}-{}x{}-{}", slugify(scene.name, "scene"), o.width, o.height, to_string(base.device));
   const std::string image_dir = "images/" + stem;
   check_output_path((fs::path(dir) / (stem + ".json")).string(), "--out-dir");  // before the sweep
@@ -310,8 +309,8 @@ int run_accuracy(AccuracyOptions& o) {
     case ToolRun::Unavailable: break;
   }
   fmt::print(stderr,
-             "accuracy: FLIP, the table and the plots were not made (no .venv at the source tree; scripts/install-deps.sh "
-             "makes it); then run: {}\n",
+             "accuracy: FLIP, the table and the plots were not made (no Python with numpy and matplotlib, or no "
+             "pathbench tools: set PATHBENCH_PYTHON; scripts/install-deps.sh makes the tree's .venv); then run: {}\n",
              command);
   return 0;
 }

@@ -22,7 +22,8 @@ struct AccuracyOptions {
   uint32_t max_spp = 4096;    // the ladder's last rung at most
   double max_seconds = 20;    // a configuration's ladder stops before a render expected to take longer
   std::string configs;        // comma-separated configuration names; empty: all
-  std::string out_dir;        // default results/<machine>/accuracy
+  std::string out_dir;        // default pathbench-out/<machine>/accuracy (results/... with update_committed)
+  bool update_committed = false;
   uint64_t seed = 1;
   int threads = 0;
   bool quick = false;         // tiny sizes for a smoke test

@@ -1,8 +1,6 @@
 #include "crosscheck_command.h"
 
 #include <fmt/core.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -11,6 +9,7 @@
 
 #include "cli_checks.h"
 #include "mitsuba_export.h"
+#include "python_tools.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/scene_library.h"
@@ -39,28 +38,9 @@ void add_crosscheck_options(CLI::App& cmd, CrosscheckOptions& o) {
 
 namespace {
 
-// tools/crosscheck.py through the tree's .venv (PATHBENCH_PYTHON overrides); its exit status.
+// tools/crosscheck.py through the one Python launcher (needs numpy and Mitsuba 3); its exit status.
 int run_tool(const std::vector<std::string>& args) {
-  const fs::path src(PATHBENCH_SOURCE_DIR);
-  std::string python = (src / ".venv" / "bin" / "python").string();
-  if (const char* env = std::getenv("PATHBENCH_PYTHON"); env && *env) python = env;
-  else if (!fs::exists(python)) python = "python3";
-  std::vector<std::string> all{python, (src / "tools" / "crosscheck.py").string()};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error(fmt::format("crosscheck: fork: {}", std::strerror(errno)));
-  if (pid == 0) {
-    execvp(argv[0], argv.data());
-    fmt::print(stderr, "pathbench: error: crosscheck: cannot run {}: {}\n", python, std::strerror(errno));
-    _exit(kExitBadInput);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : kExitFailed;
+  return run_python_tool({"crosscheck", "crosscheck.py", {"numpy", "mitsuba"}}, args);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@ namespace pb::app {
 struct CrosscheckOptions {
   std::string scene;
   std::string mitsuba_xml;  // the reference scene; default: SCENE itself if .xml, else exported
-  std::string out_dir = "crosscheck";
+  std::string out_dir = "pathbench-out/crosscheck";
   std::string device = "all";
   std::string variant = "scalar_rgb";
   unsigned width = 0, height = 0;  // 0: the scene file's film, else 64 x 48

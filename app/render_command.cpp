@@ -44,7 +44,7 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--instancing", o.choices.instancing,
                  "acceleration structure from the scene's instances (CPU: Embree instances, GPU: a two-level BVH): "
                  "auto (GPU: where the scene has instances; CPU: flat), on, or off (the flat triangles); the GPU's image "
-                 "is the flat one bit for bit, the CPU's with 'on' but for rare rays meeting a copy's edge (cpu/NOTES.md)")
+                 "is the flat one bit for bit, the CPU's with 'on' but for rare rays meeting a copy's edge (docs/notes/cpu-log.md)")
       ->capture_default_str();
   cmd.add_option("--isa", o.choices.isa,
                  "CPU: instruction set of the batched path step: auto (widest the CPU has), avx512, avx2 or scalar; "
@@ -128,7 +128,7 @@ ImageMetadata image_metadata(const RunReport& report) {
   for (const char* key : {"width", "height", "spp", "bounces", "russian_roulette", "sampling", "watertight", "precision",
                           "device", "strategy", "seed"})
     if (j.contains(key)) settings[key] = j[key];
-  // Instanced or not: on the CPU it can change rare pixels (cpu/NOTES.md).
+  // Instanced or not: on the CPU it can change rare pixels (docs/notes/cpu-log.md).
   settings["instancing"] = to_string(report.settings.instancing);
   if (j.contains("instancing")) settings["instanced"] = j["instancing"].value("used", false);
   return {{"Software", fmt::format("pathbench {}", version_number())},

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli_checks.h"
+#include "output_dirs.h"
 #include "pathbench/common/output_file.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
@@ -96,7 +97,9 @@ uint32_t reduced_spp_for_budget(const Scene& scene, uint32_t spp, double budget_
 
 void add_reproduce_options(CLI::App& cmd, ReproduceOptions& o) {
   cmd.add_option("--device", o.device, "cpu, gpu, or all (cpu, plus gpu when there is one)")->capture_default_str();
-  cmd.add_option("--out-dir", o.out_dir, "where to write images, reports and the table (default results/<machine>)");
+  cmd.add_option("--out-dir", o.out_dir, "where to write images, reports and the table (default pathbench-out/<machine>)");
+  cmd.add_flag("--update-committed", o.update_committed,
+               "maintainers: write into the committed results/<machine>/ instead of pathbench-out/<machine>/");
   cmd.add_option("--spp", o.spp, "samples per pixel (the paper: 800)")->check(non_negative())->capture_default_str();
   cmd.add_option("--uniform-spp", o.uniform_spp,
                  "samples per pixel for the CPU uniform rows (0: --spp, or fewer if --budget needs it); times are scaled to --spp in the table")
@@ -123,7 +126,7 @@ int run_reproduce(const ReproduceOptions& o) {
   if (o.device == "gpu" && !have_gpu) throw InputError(fmt::format("--device gpu: {}", why_no_gpu));
   if (o.device != "cpu" && have_gpu) devices.push_back(Device::Gpu);
 
-  const std::string dir = o.out_dir.empty() ? "results/" + machine_slug() : o.out_dir;
+  const std::string dir = output_dir(o.out_dir, o.update_committed, machine_slug());
   check_output_path(dir + "/paper-cornell.md", "--out-dir");  // before minutes of rendering
   const Scene scene = make_paper_cornell();
   const auto t_start = std::chrono::steady_clock::now();

@@ -2,7 +2,7 @@
 // `pathbench reproduce`: the 2015 paper's experiment (paper-cornell, 256x256, 800 spp,
 // 2 bounces; uniform sampling as the paper did, and light sampling) on the CPU and,
 // where there is one, the GPU, every strategy, printed beside the paper's own figures.
-// Writes results/<machine>/paper-cornell.md (the table), paper-cornell-report.json
+// Writes pathbench-out/<machine>/ (results/<machine>/ with --update-committed): paper-cornell.md (the table), paper-cornell-report.json
 // (one RunReport per row), paper-cornell.png / .exr and per-device images.
 #include <CLI/CLI.hpp>
 
@@ -13,7 +13,8 @@ namespace pb::app {
 
 struct ReproduceOptions {
   std::string device = "all";   // cpu, gpu or all (= cpu, plus gpu when present)
-  std::string out_dir;          // default results/<machine>
+  std::string out_dir;          // default pathbench-out/<machine> (results/<machine> with update_committed)
+  bool update_committed = false;
   uint32_t spp = 800;
   uint32_t uniform_spp = 0;     // spp of the CPU uniform rows; 0 = spp, or fewer if the budget needs it
   double budget_s = 100;        // seconds for the CPU rows; over it, all CPU rows but the image row

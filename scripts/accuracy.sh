@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The speed/accuracy study (README, "Speed against accuracy"): builds, then runs
+# The speed/accuracy study (docs/user-guide.md, "Speed against accuracy"): builds, then runs
 # `pathbench accuracy` on paper-cornell and cornell-box at 128x128 on the CPU, and on the
-# GPU where there is one. References are cached under results/<machine>/accuracy/, so a
+# GPU where there is one. References are cached in the output folder (pathbench-out/<machine>/accuracy/;
+# with --update-committed, the committed results/<machine>/accuracy/), so a
 # re-run (on a quiet machine, for clean times) renders only the sweep. Extra arguments
 # go to every `pathbench accuracy` call (e.g. --max-seconds 40).
 set -euo pipefail
