@@ -93,7 +93,7 @@ int run_python_tool(const PythonTool& tool, const std::vector<std::string>& args
   }
   const std::string python = find_python();
   std::string need;
-  for (const std::string& m : tool.requires) need += (need.empty() ? "" : ",") + m;
+  for (const std::string& m : tool.modules) need += (need.empty() ? "" : ",") + m;
   const std::string target = tool.target.ends_with(".py") ? (fs::path(tools) / tool.target).string() : tool.target;
   std::vector<std::string> all{python, "-c", kBootstrap, (quiet_if_missing ? "?" : "") + tool.command, need, target};
   all.insert(all.end(), args.begin(), args.end());

@@ -15,7 +15,7 @@ namespace pb::app {
 struct PythonTool {
   std::string command;                // the subcommand, for messages ("history")
   std::string target;                 // a module run as -m ("history") or a script in the tools ("crosscheck.py")
-  std::vector<std::string> requires;  // modules that must import ("numpy", "mitsuba")
+  std::vector<std::string> modules;   // modules that must import ("numpy", "mitsuba")
 };
 
 // Where the tools are, or "" when not found (`looked` gets the places tried).
