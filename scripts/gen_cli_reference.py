@@ -25,11 +25,11 @@ def helptext(binary: str, args: list[str]) -> str | None:
     if p.returncode != 0:
         return None
     # Paths of the machine that generated it never belong in the page.
-    return p.stdout.replace(str(ROOT), "<source>").rstrip()
+    return p.stdout.replace(binary, "pathbench").replace(str(ROOT), "<source>").rstrip()
 
 
 def subcommands(top: str) -> list[str]:
-    m = re.search(r"^SUBCOMMANDS:\n((?:\s+\S.*\n?)+)", top, flags=re.M)
+    m = re.search(r"^SUBCOMMANDS:\n((?:[ \t]+\S.*\n?)+)", top, flags=re.M | re.I)
     return [line.split()[0] for line in m.group(1).splitlines() if line.strip()] if m else []
 
 
