@@ -129,3 +129,11 @@ def test_pip_install_in_a_fresh_venv(tmp_path, python):
                        text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-3000:]
     assert str(venv) in r.stdout  # the installed copy, not the build folder
+    # The command line beside the module (pyproject.toml, cmake/install.cmake): run from / with the
+    # tools of the venv, the source tree's tools/ not needed.
+    assert (venv / "bin" / "pathbench").is_file() and (venv / "bin" / "pathbench-bench").is_file()
+    assert (venv / "share" / "pathbench" / "tools" / "history" / "__main__.py").is_file()
+    r = subprocess.run([str(venv / "bin" / "pathbench"), "history", "rebuild", "--db", str(tmp_path / "h.sqlite"),
+                        "--export", str(ROOT / "results" / "history" / "runs")], env=env, cwd="/",
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-3000:]
