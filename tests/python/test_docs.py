@@ -227,3 +227,19 @@ def test_installed_pathbench_stands_alone(tmp_path):
 def _has_mitsuba(python: str) -> bool:
     exe = shutil.which(python)
     return exe is None or subprocess.run([exe, "-c", "import mitsuba"], capture_output=True).returncode == 0
+
+
+# Pages other work adds (linked from here before they land).
+OTHERS_PAGES = {"docs/suite.md", "docs/suite-workloads.md", "docs/mpi.md", "docs/history.md"}
+
+
+def test_relative_links_resolve():
+    pages = PAGES + ["results/README.md", "docs/notes/cpu-log.md", "docs/notes/gpu-log.md"]
+    for page in pages:
+        text = re.sub(r"^```.*?^```", "", (ROOT / page).read_text(), flags=re.M | re.S)
+        for target in re.findall(r"\]\(([^)\s]+)\)", text):
+            if re.match(r"^(https?:|mailto:|#)", target):
+                continue
+            path = (ROOT / page).parent / target.split("#")[0]
+            rel = os.path.relpath(path.resolve(), ROOT)
+            assert path.exists() or rel in OTHERS_PAGES, f"{page}: broken link {target}"
