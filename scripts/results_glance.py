@@ -23,7 +23,7 @@ STRATEGIES = ("pixel", "wavefront", "paper-queue")
 
 
 def latest_frames(runs_dir: Path) -> dict:
-    """(machine, device) -> (commit_date or run_date, commit, {strategy: median ms})."""
+    """(machine, device) -> ((commit_date, run_date), commit, {strategy: median ms}, the device's name)."""
     best: dict = {}
     for path in sorted(glob.glob(str(runs_dir / "*.jsonl"))):
         lines = Path(path).read_text().splitlines()
@@ -35,21 +35,24 @@ def latest_frames(runs_dir: Path) -> dict:
             if m and row.get("value") is not None and row.get("unit") == "ms":
                 values.setdefault((m.group(1), m.group(2)), []).append(row["value"])
         when = run.get("commit_date") or run.get("run_date") or ""
+        ctx = run.get("context") or {}
+        names = {"cpu": ctx.get("cpu_model") or "", "gpu": ctx.get("gpu_name") or ""}
         for device in {d for d, _ in values}:
             key = (run["machine_name"], device)
             medians = {s: statistics.median(v) for (d, s), v in values.items() if d == device}
             if key not in best or (when, run.get("run_date") or "") > best[key][0]:
-                best[key] = ((when, run.get("run_date") or ""), run["commit"][:7], medians)
+                best[key] = ((when, run.get("run_date") or ""), run["commit"][:7], medians, names[device])
     return best
 
 
 def table(runs_dir: Path) -> str:
-    rows = ["| machine | device | pixel | wavefront | paper-queue | commit | date |",
+    rows = ["| machine (history name) | device | pixel | wavefront | paper-queue | commit | date |",
             "|---|---|---:|---:|---:|---|---|"]
-    for (machine, device), ((when, _), commit, med) in sorted(latest_frames(runs_dir).items()):
+    for (machine, device), ((when, _), commit, med, name) in sorted(latest_frames(runs_dir).items()):
         cells = [f"{med[s] / 1000:.2f} s" if med.get(s, 0) >= 1000 else f"{med[s]:.1f} ms" if s in med else "–"
                  for s in STRATEGIES]
-        rows.append(f"| {machine} | {device} | " + " | ".join(cells) + f" | {commit} | {when[:10]} |")
+        label = f"{device}: {name}" if name else device
+        rows.append(f"| {machine} | {label} | " + " | ".join(cells) + f" | {commit} | {when[:10]} |")
     return "\n".join(rows)
 
 
