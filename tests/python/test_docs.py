@@ -24,6 +24,9 @@ needs_binary = pytest.mark.skipif(not PATHBENCH.exists(), reason="build/bin/path
 MAYBE_ABSENT = {"suite"}
 # Run in full (they take seconds here); every other command is checked against --help.
 RUN = {"render", "compare", "history", "accuracy", "crosscheck"}
+# What each prints, as the README's one line says.
+PRINTS = {"render": r"M rays/s", "compare": r"verdict", "history record": r"recorded .* rows",
+          "accuracy": r"rows written", "crosscheck": r"crosscheck: .* against Mitsuba 3"}
 
 
 def blocks(page: str) -> list[tuple[str, str]]:
@@ -150,6 +153,9 @@ def test_commands_run(tmp_path):
         p = run_line(words, tmp_path, tmp_path)
         allowed = {0, 1} if words[0] in ("compare", "crosscheck") else {0}
         assert p.returncode in allowed, f"{page}: {line}: exit {p.returncode}\n{p.stderr[-2000:]}"
+        expect = PRINTS.get(words[0] if words[0] != "history" else f"history {words[1]}")
+        if expect:
+            assert re.search(expect, p.stdout + p.stderr), f"{page}: {line}: printed no {expect!r}:\n{p.stdout[-1000:]}"
         ran += 1
     assert ran >= 8
 
