@@ -49,6 +49,8 @@ int run_crosscheck(CrosscheckOptions& o) {
   if (o.device != "cpu" && o.device != "gpu" && o.device != "all")
     throw InputError(fmt::format("--device: unknown device '{}' (cpu, gpu or all)", o.device));
   if (o.spp == 0 || o.mitsuba_spp_factor == 0) throw InputError("--spp, --mitsuba-spp-factor: must be at least 1");
+  // Python and Mitsuba first: a missing one is one line and exit 2 before any rendering.
+  if (const int s = run_python_tool({"crosscheck", "", {"numpy", "mitsuba"}}, {}); s != 0) return s;
   const Scene scene = load_scene(o.scene, {.strict = o.strict});
   const SceneRenderDefaults& d = scene.render_defaults;
   const bool own_xml = o.mitsuba_xml.empty() && image_extension(o.scene) == ".xml";

@@ -46,6 +46,8 @@ if missing:
     quiet = cmd.startswith("?")
     sys.stderr.write(("%s: note:" if quiet else "pathbench: error: %s:") % cmd.lstrip("?") + " the Python at %s lacks %s (pip install %s into it, or set PATHBENCH_PYTHON to a Python that has it)\n" % (sys.executable, ", ".join(missing), " ".join(missing)))
     sys.exit(2)
+if not target:
+    sys.exit(0)
 sys.argv = [target] + sys.argv[4:]
 if target.endswith(".py"):
     runpy.run_path(target, run_name="__main__")

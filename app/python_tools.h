@@ -14,7 +14,8 @@ namespace pb::app {
 
 struct PythonTool {
   std::string command;                // the subcommand, for messages ("history")
-  std::string target;                 // a module run as -m ("history") or a script in the tools ("crosscheck.py")
+  std::string target;                 // a module run as -m ("history") or a script in the tools ("crosscheck.py");
+                                      // "" only checks that Python, the tools and the modules are there
   std::vector<std::string> modules;   // modules that must import ("numpy", "mitsuba")
 };
 
