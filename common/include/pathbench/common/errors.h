@@ -11,7 +11,7 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The exit-status contract (README, "Command line"): 0 done, 1 a regression found
+// The exit-status contract (docs/reference.md, "Exit codes"): 0 done, 1 a regression found
 // (compare, history), 2 a user error, anything else a bug -- kExitFailed for an
 // unexpected exception, so that a script never reads a crash as "regression".
 constexpr int kExitRegression = 1;

@@ -26,7 +26,7 @@ std::string fnv1a64_hex(std::string_view text);
 
 // This process's fingerprint: host_fingerprint("/") plus "os" (uname), "build"
 // (compiler, flags, build type, ISA compiled for, git revision) and "libraries"
-// (versions compiled against). Computed once per process; schema in README.
+// (versions compiled against). Computed once per process; schema in docs/reference.md, "Machine fingerprint".
 // Tracers add their own sections ("embree", "gpu") through pb::run::run_fingerprint (run/run_context.h).
 const nlohmann::json& machine_fingerprint();
 

@@ -1,7 +1,7 @@
 #pragma once
 // The ranges pathbench supports, in one place: every reader and every check (scene
 // finalize, the scene-file readers, the Python ray arrays, compare's readers) uses
-// these constants, and the README documents them. Input outside them is a user error
+// these constants, and docs/reference.md ("Scenes and supported ranges") documents them. Input outside them is a user error
 // (InputError: exit 2, or ValueError in Python), refused before Embree or the film
 // sees it.
 #include <cstdint>
