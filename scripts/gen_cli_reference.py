@@ -13,6 +13,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from generated_block import update
+
 ROOT = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- cli-reference:begin -->", "<!-- cli-reference:end -->"
 # `history` hands over to tools/history: its sub-subcommands each have a --help.
@@ -60,18 +62,8 @@ def main(argv=None) -> int:
     g.add_argument("--check", type=Path)
     a = ap.parse_args(argv)
     page = a.write or a.check
-    text = page.read_text()
-    current = text[text.index(BEGIN):text.index(END) + len(END)]
-    new = block(a.pathbench)
-    if a.check:
-        if current != new:
-            print(f"gen_cli_reference: {page}: the command-line reference is stale; run "
-                  f"scripts/gen_cli_reference.py --write {page}", file=sys.stderr)
-            return 1
-        return 0
-    page.write_text(text.replace(current, new))
-    return 0
-
+    return update(page, BEGIN, END, block(a.pathbench), check=bool(a.check), tool="gen_cli_reference",
+                  remedy=f"scripts/gen_cli_reference.py --write {page}")
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -16,6 +16,8 @@ import statistics
 import sys
 from pathlib import Path
 
+from generated_block import update
+
 ROOT = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- results-glance:begin (scripts/results_glance.py) -->", "<!-- results-glance:end -->"
 FRAME = re.compile(r"^render/(cpu|gpu)/([a-z-]+)/paper-cornell/256x256/spp:800/bounces:2/nee/")
@@ -74,20 +76,8 @@ def main(argv=None) -> int:
     if target is None:
         print(new)
         return 0
-    text = target.read_text()
-    if BEGIN not in text or END not in text:
-        print(f"results_glance: {target}: no {BEGIN} ... {END} markers", file=sys.stderr)
-        return 2
-    current = text[text.index(BEGIN):text.index(END) + len(END)]
-    if a.check:
-        if current != new:
-            print(f"results_glance: {target}: the results table is stale; run scripts/maintainer/update-results.sh glance",
-                  file=sys.stderr)
-            return 1
-        return 0
-    target.write_text(text.replace(current, new))
-    return 0
-
+    return update(target, BEGIN, END, new, check=bool(a.check), tool="results_glance",
+                  remedy="scripts/maintainer/update-results.sh glance")
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -257,3 +257,13 @@ def test_relative_links_resolve():
             path = (ROOT / page).parent / target.split("#")[0]
             rel = os.path.relpath(path.resolve(), ROOT)
             assert path.exists() or rel in OTHERS_PAGES, f"{page}: broken link {target}"
+
+
+def test_a_stale_generated_block_is_caught(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text((ROOT / "README.md").read_text().replace(" ms |", " ms  |", 1))
+    p = subprocess.run([sys.executable, str(ROOT / "scripts/results_glance.py"), "--check", str(readme)],
+                       capture_output=True, text=True)
+    assert p.returncode == 1 and "stale" in p.stderr
+    p = subprocess.run([sys.executable, str(ROOT / "scripts/results_glance.py"), "--write", str(readme)])
+    assert p.returncode == 0 and readme.read_text() == (ROOT / "README.md").read_text()
