@@ -118,4 +118,11 @@ void RankTracer::finish(Film& film, RunReport& report) {
 #endif
 }
 
+gpu::DeviceFilm* RankTracer::device_film() {
+#if PATHBENCH_HAVE_CUDA
+  if (gpu_ && gpu_->film.used()) return &gpu_->film;
+#endif
+  return nullptr;
+}
+
 }  // namespace pb::run

@@ -10,6 +10,10 @@
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 
+namespace pb::gpu {
+class DeviceFilm;
+}
+
 namespace pb::run {
 
 class RankTracer {
@@ -32,6 +36,9 @@ class RankTracer {
   void warm_up(Film& film);
   // After the rank's last block: a GPU rank's film comes back from the device (once).
   void finish(Film& film, RunReport& report);
+  // A GPU rank's film on the device (what finish() downloads), for a reduction on the
+  // GPUs; null on a CPU rank or before the first block.
+  gpu::DeviceFilm* device_film();
 
  private:
   const Scene& scene_;

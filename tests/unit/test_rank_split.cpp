@@ -160,6 +160,15 @@ TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
   EXPECT_LE(busy_until[1], busy_until[0] * 1.05);
 }
 
+// Issue 30: a rank with >= 98 % of the total rate (a GPU beside a slow CPU rank) takes all
+// that is left in one chunk, so the hybrid's GPU makes one more call at most, not a tail of
+// shrinking chunks; just under the threshold the share rule still applies.
+TEST(RankSplit, ADominantRankTakesTheRest) {
+  EXPECT_EQ(run::chunk_size(204800, 8192, 99.0, 100.0), 204800u);
+  EXPECT_EQ(run::chunk_size(204800, 8192, run::kDominantShare, 1.0), 204800u);
+  EXPECT_LT(run::chunk_size(204800, 8192, 97.0, 100.0), 204800u);
+}
+
 TEST(RankSplit, OneProcessIsOneRank) {
   run::World& w = run::World::get();
   EXPECT_EQ(w.size(), 1);

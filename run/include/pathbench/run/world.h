@@ -125,6 +125,8 @@ class SampleDispenser {
 // `rate` among ranks of total rate `total_rate` (rates of ranks not measured yet counted
 // as the mean of the measured ones by the caller); `probe` units while its rate is
 // unknown, and never less than that (the last crumbs go to whoever asks first).
+// A rank of at least kDominantShare of the total rate gets all that is left.
 uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double total_rate);
+constexpr double kDominantShare = 0.98;
 
 }  // namespace pb::run
