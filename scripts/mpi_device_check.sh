@@ -31,9 +31,13 @@ if has build; then
         -DPATHBENCH_NCCL=${PATHBENCH_NCCL:-AUTO} \
         -DCMAKE_CUDA_ARCHITECTURES=90 > "$OUT/configure.txt" 2>&1 || { tail -30 "$OUT/configure.txt"; exit 1; }
   log "$(grep -E 'pathbench: (MPI|NCCL)' "$OUT/configure.txt" | tr '\n' ' ')"
-  cmake --build $B -j "$(nproc)" --target ${TARGETS:-pathbench pathbench-bench pathbench_unit_tests pathbench_gpu_tests \
-        pathbench_gpu_stability_tests pathbench_traversal_tests} > "$OUT/build.txt" 2>&1 \
+  # pathbench first (the rest of the phases need it), then the test binaries (a failure there
+  # is logged, and the tests that need them fail).
+  cmake --build $B -j "$(nproc)" --target pathbench > "$OUT/build.txt" 2>&1 \
     || { grep -E "error|FAILED" -A3 "$OUT/build.txt" | head -60; exit 1; }
+  cmake --build $B -j "$(nproc)" --target ${TARGETS:-pathbench-bench pathbench_unit_tests pathbench_gpu_tests \
+        pathbench_gpu_stability_tests pathbench_traversal_tests} >> "$OUT/build.txt" 2>&1 \
+    || { grep -E "error|FAILED" -A3 "$OUT/build.txt" | head -60; log "BUILD OF TEST TARGETS FAILED"; }
   log "build ok"
   (cd $B && ctest -L mpi --output-on-failure -j4 > "$OUT/ctest-mpi.txt" 2>&1; tail -4 "$OUT/ctest-mpi.txt")
   log "ctest -L mpi: $(grep -E 'tests passed|tests failed' "$OUT/ctest-mpi.txt")"

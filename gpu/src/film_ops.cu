@@ -30,17 +30,20 @@ __global__ void max_abs_kernel(const unsigned long long* v, uint64_t n, unsigned
 
 uint64_t max_abs_sum_on_device(const unsigned long long* sums, uint64_t n) {
   if (n == 0) return 0;
-  DeviceBuffer<unsigned long long> out(1, "the film's largest sum", "nothing (8 bytes)");
-  PB_CUDA_CHECK(cudaMemset(out.get(), 0, sizeof(unsigned long long)));
+  // 8 bytes kept for the process (one device per process: an MPI rank's), so that the check
+  // costs a kernel and two small copies, not an allocation and a synchronising free.
+  static unsigned long long* out = nullptr;
+  if (!out) PB_CUDA_CHECK(cudaMalloc(&out, sizeof(unsigned long long)));
+  PB_CUDA_CHECK(cudaMemset(out, 0, sizeof(unsigned long long)));
   int device = 0, sms = 1;
   PB_CUDA_CHECK(cudaGetDevice(&device));
   PB_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
   const uint64_t want = (n + 255) / 256;
   const unsigned blocks = unsigned(want < uint64_t(sms) * 8 ? want : uint64_t(sms) * 8);
-  max_abs_kernel<<<blocks, 256>>>(sums, n, out.get());
+  max_abs_kernel<<<blocks, 256>>>(sums, n, out);
   PB_CUDA_CHECK(cudaGetLastError());
   unsigned long long m = 0;
-  out.download(&m, 1);  // synchronous on the default stream: after the kernel
+  PB_CUDA_CHECK(cudaMemcpy(&m, out, sizeof m, cudaMemcpyDeviceToHost));  // after the kernel (default stream)
   return m;
 }
 

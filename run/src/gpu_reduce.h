@@ -44,8 +44,9 @@ bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, do
                       double& nccl_seconds);
 
 // While it lives, `film`'s host arrays are page-locked for the device's copies (the one
-// download of the reduced film runs at the bus's speed, not through a bounce buffer);
-// nothing without NCCL or where locking fails. Made before the frame's clock starts.
+// download of a GPU rank's film runs at the bus's speed, not through a bounce buffer);
+// nothing in a build without NCCL, or where locking fails. Made before the frame's clock
+// starts, undone when the frame is over.
 class PinnedFilm {
  public:
   PinnedFilm(Film& film, bool pin);

@@ -162,7 +162,9 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   const bool cpu_ranks = std::find(devices.begin(), devices.end(), "cpu") != devices.end();
   // MPI has nothing left to add where NCCL brought every film to rank 0.
   const bool mpi_after_nccl = cpu_ranks || gred.root != 0;
-  PinnedFilm pinned(film, gred.nccl && w.rank() == gred.root);
+  // A GPU rank that downloads a film it keeps (NCCL's root, or every GPU rank without NCCL)
+  // downloads into page-locked memory.
+  PinnedFilm pinned(film, s.device == Device::Gpu && (!gred.nccl || w.rank() == gred.root));
 
   // 3. The frame: from a common start to the reduced film on rank 0.
   const nlohmann::json load0 = load_sample();
