@@ -3,7 +3,7 @@
 # NCCL where found: PATHBENCH_NCCL=ON to insist), run the mpi tests, check that 2 GPU ranks (on one GPU when only one is visible) and the
 # CPU+GPU hybrid give the one-GPU image byte for byte, that pathbench-bench's GPU render
 # benchmarks over 2 ranks give one process's film hashes, and run tools/mpi_scaling.py.
-# Everything lands under $OUT (default ./device-out). Phases: build gpu check bench scaling
+# Everything lands under $OUT (default ./device-out). Phases: build gpu check bench reduce scaling
 # hybrid (gpu: ctest -L gpu in the same build, GPU_TESTS=regex for a subset; hybrid: one GPU
 # alone against the hybrid, interleaved rounds, REPS=5 by default; scaling: tools/mpi_scaling.py
 # --gpus <all visible>, SCALING_REPS=3, CPU_RANKS=1,2,4). TARGETS: what to build.
@@ -108,6 +108,24 @@ print(f"{same}/{len(h1)} GPU render benchmarks with one process's film hash over
                 f"{rows[k + '/manual_time']['parallel_efficiency']:.2f}" for k in sorted(h2)))
 EOF_PY
 )"
+fi
+if has reduce; then
+  # The GPU ranks' reduction, NCCL against MPI (PATHBENCH_FILM_REDUCE=mpi), 2 GPU ranks,
+  # interleaved rounds (REPS, 3 here by default): frame and reduce seconds of each.
+  mkdir -p "$OUT/reduce"
+  for frame in "256 256 800" "2048 2048 1024"; do
+    set -- $frame
+    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2 --device gpu"
+    for i in $(seq 1 ${REDUCE_REPS:-3}); do
+      for how in nccl mpi; do
+        PATHBENCH_FILM_REDUCE=$how mpi -np 2 $PB $f --out "$OUT/r.pfm" --report "$OUT/reduce/$how-$1-$i.json"
+      done
+    done
+  done
+  rm -f "$OUT/r.pfm"
+  for p in "$OUT"/reduce/*.json; do
+    log "reduce $(basename "$p" .json): $(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['ranks']; print(f\"frame {r['frame_seconds']:.5f} s reduce {r['reduce_seconds']:.5f} s ({r['reduction']['gpu_ranks']}) parts\", [p.get('reduce_parts') for p in r['per_rank']][0])" "$p")"
+  done
 fi
 if has scaling; then
   PYTHONUNBUFFERED=1 python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" \

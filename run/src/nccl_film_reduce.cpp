@@ -102,6 +102,29 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index) {
   return r;
 }
 
+namespace {
+// Adds the GPU ranks' device films onto the GPU communicator's rank 0, in place there.
+void nccl_reduce(gpu::DeviceFilm& film) {
+  const gpu::DeviceFilm::Arrays a = film.arrays();
+  nccl_check(ncclGroupStart(), "ncclGroupStart");
+  nccl_check(ncclReduce(a.sums, a.sums, a.pixels * 3, ncclInt64, ncclSum, 0, current->nccl, current->stream),
+             "ncclReduce (sums)");
+  nccl_check(ncclReduce(a.counts, a.counts, a.pixels, ncclUint32, ncclSum, 0, current->nccl, current->stream),
+             "ncclReduce (counts)");
+  if (a.sum_sq)
+    nccl_check(ncclReduce(a.sum_sq, a.sum_sq, a.pixels * 3, ncclFloat64, ncclSum, 0, current->nccl, current->stream),
+               "ncclReduce (variance sums)");
+  nccl_check(ncclGroupEnd(), "ncclGroupEnd");
+  cuda_check(cudaStreamSynchronize(current->stream), "cudaStreamSynchronize (NCCL)");
+}
+}  // namespace
+
+void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film) {
+  if (!r.nccl || !current || !film) return;
+  (void)film->max_abs_sum();
+  nccl_reduce(*film);  // zeros onto zeros: the root's film stays cleared
+}
+
 bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
                       double& nccl_seconds) {
   using Clock = std::chrono::steady_clock;
@@ -118,22 +141,8 @@ bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, do
   if (bound > (unsigned __int128)INT64_MAX) return false;  // every rank sees the same bound
   if (!film) return true;
   const auto t1 = Clock::now();
-  const gpu::DeviceFilm::Arrays a = film->arrays();
-  int grank = 0;
-  MPI_Comm_rank(current->gpus, &grank);
-  const bool root = grank == 0;
   // In place on the root (send = receive buffer); the others' receive buffers are unused.
-  nccl_check(ncclGroupStart(), "ncclGroupStart");
-  nccl_check(ncclReduce(a.sums, a.sums, a.pixels * 3, ncclInt64, ncclSum, 0, current->nccl, current->stream),
-             "ncclReduce (sums)");
-  nccl_check(ncclReduce(a.counts, a.counts, a.pixels, ncclUint32, ncclSum, 0, current->nccl, current->stream),
-             "ncclReduce (counts)");
-  if (a.sum_sq)
-    nccl_check(ncclReduce(a.sum_sq, a.sum_sq, a.pixels * 3, ncclFloat64, ncclSum, 0, current->nccl, current->stream),
-               "ncclReduce (variance sums)");
-  nccl_check(ncclGroupEnd(), "ncclGroupEnd");
-  cuda_check(cudaStreamSynchronize(current->stream), "cudaStreamSynchronize (NCCL)");
-  (void)root;
+  nccl_reduce(*film);
   nccl_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
   return true;
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <stdexcept>
@@ -165,6 +166,25 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // A GPU rank that downloads a film it keeps (NCCL's root, or every GPU rank without NCCL)
   // downloads into page-locked memory.
   PinnedFilm pinned(film, s.device == Device::Gpu && (!gred.nccl || w.rank() == gred.root));
+  on_every_rank([&] { warm_gpu_reduction(gred, tracer->device_film()); });
+  // Dynamic balancing: a rank's probe chunk measures its rate: ~2 M samples fill a GPU (an
+  // H100 runs ~270 k threads at once), 64 per thread keep a CPU rank's short. Each rank
+  // traces one before the frame's clock starts (as it warms up), and every rank's rate
+  // seeds the dispenser, so the first grants already follow the rates: a GPU that does
+  // nearly all of the work takes the frame in one chunk.
+  const uint64_t probe_samples = s.device == Device::Gpu ? uint64_t(1) << 21 : uint64_t(std::max(1, s.threads)) * 64;
+  const uint64_t probe = std::max<uint64_t>(1, (probe_samples + s.width - 1) / s.width);
+  std::vector<double> rates;
+  if (balance == Balance::Dynamic) {
+    double rate = 0;
+    on_every_rank([&] {
+      const uint64_t n = std::min<uint64_t>(probe, uint64_t(s.height) * s.spp);
+      double seconds = 0;
+      for (const FrameBlock& b : blocks_of({0, n}, s.spp, s.height)) seconds += tracer->calibrate(b, film, scene.max_emission());
+      rate = seconds > 0 ? double(n) / seconds : 0.0;
+    });
+    for (const std::string& r : w.all(fmt::format("{:a}", rate))) rates.push_back(std::strtod(r.c_str(), nullptr));
+  }
 
   // 3. The frame: from a common start to the reduced film on rank 0.
   const nlohmann::json load0 = load_sample();
@@ -184,18 +204,13 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   {
     // Dynamic balancing only: rank 0 then serves it (its units: rows x samples).
     std::optional<SampleDispenser> dispenser;
-    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp);
+    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
     try {
       if (balance == Balance::Static) {
         const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
         if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
-        // A rank's first chunk measures its rate: ~2 M samples fill a GPU (an H100 runs
-        // ~270 k threads at once), a few hundred per thread keep a CPU rank's probe short.
-        // (64 per thread: a CPU rank's first chunk ends within a small GPU frame.)
-        const uint64_t probe_samples = s.device == Device::Gpu ? uint64_t(1) << 21 : uint64_t(s.threads) * 64;
-        const uint64_t probe = std::max<uint64_t>(1, (probe_samples + s.width - 1) / s.width);
-        double rate = 0;  // units per second in the last chunk
+        double rate = rates.empty() ? 0.0 : rates[size_t(w.rank())];  // units per second in the last chunk
         for (;;) {
           const UnitRange range = dispenser->next(rate, probe);
           if (range.count == 0) break;

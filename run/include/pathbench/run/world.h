@@ -99,8 +99,12 @@ int launcher_rank();
 // Every rank constructs it and calls finish(); next() and abort() are per rank.
 class SampleDispenser {
  public:
-  // `units`: the frame's (rows x spp).
-  SampleDispenser(World& world, uint64_t units);
+  // `units`: the frame's (rows x spp). `rates`: every rank's units per second as measured
+  // before the frame (a probe chunk each, RankTracer::calibrate), in rank order, or empty:
+  // then the first grants are probes. A rank whose chunk would outlast the frame's
+  // projected end (what is left / the ranks' total rate) gets none, unless it is the
+  // fastest: a slow rank never holds the frame up.
+  SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates = {});
   ~SampleDispenser();
   SampleDispenser(const SampleDispenser&) = delete;
   SampleDispenser& operator=(const SampleDispenser&) = delete;
