@@ -51,6 +51,19 @@ refused() {  # STATUS-WANTED REGEX FILE
   return 0
 }
 
+# Rank 1 is a shell that starts pathbench (which joins the run as rank 1) and kills it: the
+# run ends within 30 s, non-zero, naming the killed process, with no image. $@: mpirun options.
+killed() {
+  start=$(date +%s)
+  run "$@" -np 1 "$pb" $base --spp 100000 --out x.pfm : \
+      -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
+  elapsed=$(( $(date +%s) - start ))
+  [ "$status" != 0 ] || fail "the run succeeded"
+  [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
+  [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
+  grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
+  refused "$status" "." x.pfm
+}
 # Between nodes there is no shared memory: TCP alone, on the loopback interface here.
 tcp="--mca btl self,tcp --mca btl_tcp_if_include lo --mca pml ob1 --mca osc ^sm,rdma"
 
@@ -63,16 +76,7 @@ case $case_name in
       same $balance.pfm
       [ "$(film_hash one.json)" = "$(film_hash $balance.json)" ] || fail "TCP only: film_hash differs"
     done ;;
-  tcp_killed_rank)
-    start=$(date +%s)
-    run $tcp -np 1 "$pb" $base --spp 100000 --out x.pfm : \
-        -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
-    elapsed=$(( $(date +%s) - start ))
-    [ "$status" != 0 ] || fail "the run succeeded"
-    [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
-    [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
-    grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
-    refused "$status" "." x.pfm ;;
+  tcp_killed_rank) killed $tcp ;;
   gpu_shared)
     "$pb" $frame --device gpu --out gpu.pfm --report gpu.json 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
     run -np 3 "$pb" $frame --device gpu --out x.pfm --report x.json
@@ -106,17 +110,7 @@ case $case_name in
   hybrid_no_gpu)
     run -np 2 "$pb" $frame --device hybrid --out x.pfm
     refused 2 "rank 0 of 2: --device gpu: " x.pfm ;;
-  killed_rank)
-    start=$(date +%s)
-    # Rank 1 is a shell that starts pathbench (which joins the run as rank 1) and kills it.
-    run -np 1 "$pb" $base --spp 100000 --out x.pfm : \
-        -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
-    elapsed=$(( $(date +%s) - start ))
-    [ "$status" != 0 ] || fail "the run succeeded"
-    [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
-    [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
-    grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
-    refused "$status" "." x.pfm ;;
+  killed_rank) killed ;;
   accuracy)
     "$pb" accuracy --quick --no-report-tool --out-dir one >one.log 2>&1 || { cat one.log >&2; fail "one process failed"; }
     run -np 2 "$pb" accuracy --quick --no-report-tool --out-dir two
