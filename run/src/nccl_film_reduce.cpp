@@ -14,6 +14,7 @@
 #include "gpu_reduce.h"
 #include "mpi_detail.h"
 #include "pathbench/gpu/render.h"
+#include "pathbench/run/ranks.h"
 #include "pathbench/run/world.h"
 
 namespace pb::run {
@@ -135,10 +136,8 @@ bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, do
   uint64_t largest = film ? film->max_abs_sum() : 0;
   std::vector<uint64_t> all(size_t(w.size()), 0);
   MPI_Allgather(&largest, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
-  unsigned __int128 bound = 0;
-  for (uint64_t v : all) bound += v;
   bound_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (bound > (unsigned __int128)INT64_MAX) return false;  // every rank sees the same bound
+  if (!sums_cannot_overflow(all)) return false;  // every rank sees the same values
   if (!film) return true;
   const auto t1 = Clock::now();
   // In place on the root (send = receive buffer); the others' receive buffers are unused.

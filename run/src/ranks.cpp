@@ -1,6 +1,7 @@
 #include "pathbench/run/ranks.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -72,6 +73,12 @@ bool add_rows_into(Film& into, uint32_t first_row, uint32_t rows, const int64_t*
   ok &= add_values(into.counts().data() + px0, counts, px);
   if (into.has_variance() && sum_sq) add_values(into.raw_sum_sq().data() + px0 * 3, sum_sq, px * 3);
   return ok;
+}
+
+bool sums_cannot_overflow(const std::vector<uint64_t>& largest) {
+  unsigned __int128 bound = 0;
+  for (uint64_t v : largest) bound += v;
+  return bound <= (unsigned __int128)INT64_MAX;
 }
 
 void reduce_film(Film& into, const Film& part) {

@@ -169,6 +169,17 @@ TEST(RankSplit, ADominantRankTakesTheRest) {
   EXPECT_LT(run::chunk_size(204800, 8192, 97.0, 100.0), 204800u);
 }
 
+// The bound under which the MPI and NCCL reductions add int64 sums unchecked (issue 30).
+TEST(RankSplit, SumsCannotOverflowBound) {
+  const uint64_t max = uint64_t(INT64_MAX);
+  EXPECT_TRUE(run::sums_cannot_overflow({}));
+  EXPECT_TRUE(run::sums_cannot_overflow({max}));
+  EXPECT_TRUE(run::sums_cannot_overflow({max - 5, 5, 0}));
+  EXPECT_FALSE(run::sums_cannot_overflow({max - 5, 6}));
+  EXPECT_FALSE(run::sums_cannot_overflow({max, max, max, max}));  // no wrap in the bound's own sum
+  EXPECT_FALSE(run::sums_cannot_overflow({uint64_t(1) << 63}));   // |INT64_MIN|
+}
+
 TEST(RankSplit, OneProcessIsOneRank) {
   run::World& w = run::World::get();
   EXPECT_EQ(w.size(), 1);
