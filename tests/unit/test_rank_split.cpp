@@ -140,8 +140,9 @@ TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
   EXPECT_EQ(run::chunk_size(500, 12, 1.0, 1000.0), 12u);
   EXPECT_EQ(run::chunk_size(500, 0, 1.0, 1000.0), 1u);
   EXPECT_EQ(run::chunk_size(0, 12, 1.0, 1.0), 0u);
-  // Beyond 32 bits (a 65536-row frame at 2^17 spp).
-  EXPECT_EQ(run::chunk_size(uint64_t(1) << 33, 12, 1.0, 1.0), uint64_t(0.95 * double(uint64_t(1) << 33)) + 1);
+  // Beyond 32 bits (a 65536-row frame at 2^17 spp), a rank of half the rate. (A rank of all
+  // of it takes everything: ADominantRankTakesTheRest.)
+  EXPECT_EQ(run::chunk_size(uint64_t(1) << 33, 12, 1.0, 2.0), uint64_t(0.425 * double(uint64_t(1) << 33)) + 1);
   // A GPU 30x a CPU, each asking when its chunk would end: the frame is covered exactly,
   // the GPU needs few chunks, and the CPU's work ends no later than the GPU's.
   const double rate[2] = {30.0, 1.0};
