@@ -50,4 +50,13 @@ if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
     echo "[install-deps] .venv: up to date"
   fi
 fi
+# NCCL (the GPU ranks' film reduction on the GPUs, PATHBENCH_NCCL, issue 30): where neither the
+# system nor .venv has nccl.h, NVIDIA's wheel (nvidia-nccl-cu13, ~300 MB: nccl.h + libnccl.so.2)
+# goes into .venv, where cmake/FindNCCL.cmake looks. PATHBENCH_SKIP_NCCL=1: not installed.
+if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ] && [ "${PATHBENCH_SKIP_NCCL:-0}" != 1 ] && [ -x "$root/.venv/bin/python" ] &&
+   ! ls /usr/include/nccl.h /usr/local/include/nccl.h /usr/local/cuda/include/nccl.h \
+        "$root"/.venv/lib/python3*/site-packages/nvidia/nccl/include/nccl.h >/dev/null 2>&1; then
+  echo "[install-deps] pip install nvidia-nccl-cu13 (NCCL headers and library)"
+  "$root/.venv/bin/python" -m pip install -q --no-deps nvidia-nccl-cu13==2.32.3
+fi
 echo "[install-deps] done"

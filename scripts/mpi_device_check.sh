@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# MPI ranks on a GPU host (issue 13), for the device machine: build with MPI, run the
-# mpi tests, check that 2 GPU ranks (on one GPU when only one is visible) and the
+# MPI ranks on a GPU host (issues 13, 30, 31), for the device machine: build with MPI (and
+# NCCL where found: PATHBENCH_NCCL=ON to insist), run the mpi tests, check that 2 GPU ranks (on one GPU when only one is visible) and the
 # CPU+GPU hybrid give the one-GPU image byte for byte, that pathbench-bench's GPU render
 # benchmarks over 2 ranks give one process's film hashes, and run tools/mpi_scaling.py.
-# Everything lands under $OUT (default ./device-out). Phases: build gpu check bench scaling
-# hybrid (gpu: ctest -L gpu in the same build; hybrid: one GPU alone against the hybrid,
-# interleaved rounds, REPS=5 by default).
+# Everything lands under $OUT (default ./device-out). Phases: build gpu check bench reduce scaling
+# hybrid (gpu: ctest -L gpu in the same build, GPU_TESTS=regex for a subset; hybrid: one GPU
+# alone against the hybrid, interleaved rounds, REPS=5 by default; scaling: tools/mpi_scaling.py
+# --gpus <all visible>, SCALING_REPS=3, CPU_RANKS=1,2,4). TARGETS: what to build.
 #   source .gpu-deps/unpack.sh is done here (pack-deps.sh --mpi); ../shared/gpu-host/README.md.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -27,18 +28,26 @@ log "GPUs: $gpus, mpirun: $MPIRUN"
 if has build; then
   cmake -S . -B $B -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF -DPATHBENCH_PYTHON=OFF \
         -DPATHBENCH_MPI=ON -DMPI_CXX_COMPILER=$(command -v mpicxx.openmpi || command -v mpicxx) \
+        -DPATHBENCH_NCCL=${PATHBENCH_NCCL:-AUTO} \
         -DCMAKE_CUDA_ARCHITECTURES=90 > "$OUT/configure.txt" 2>&1 || { tail -30 "$OUT/configure.txt"; exit 1; }
-  cmake --build $B -j 16 --target pathbench pathbench-bench pathbench_unit_tests pathbench_gpu_tests \
-        pathbench_gpu_stability_tests pathbench_traversal_tests > "$OUT/build.txt" 2>&1 \
+  log "$(grep -E 'pathbench: (MPI|NCCL)' "$OUT/configure.txt" | tr '\n' ' ')"
+  # pathbench first (the rest of the phases need it), then the test binaries (a failure there
+  # is logged, and the tests that need them fail).
+  cmake --build $B -j "$(nproc)" --target pathbench > "$OUT/build.txt" 2>&1 \
     || { grep -E "error|FAILED" -A3 "$OUT/build.txt" | head -60; exit 1; }
+  cmake --build $B -j "$(nproc)" --target ${TARGETS:-pathbench-bench pathbench_unit_tests pathbench_gpu_tests \
+        pathbench_gpu_stability_tests pathbench_traversal_tests} >> "$OUT/build.txt" 2>&1 \
+    || { grep -E "error|FAILED" -A3 "$OUT/build.txt" | head -60; log "BUILD OF TEST TARGETS FAILED"; }
   log "build ok"
   (cd $B && ctest -L mpi --output-on-failure -j4 > "$OUT/ctest-mpi.txt" 2>&1; tail -4 "$OUT/ctest-mpi.txt")
+  log "ctest -L mpi: $(grep -E 'tests passed|tests failed' "$OUT/ctest-mpi.txt")"
   (cd $B && ctest -R 'RankSplit|RunRanks' --output-on-failure > "$OUT/ctest-ranks.txt" 2>&1; tail -3 "$OUT/ctest-ranks.txt")
 fi
 
 if has gpu; then
-  (cd $B && ctest -L gpu --output-on-failure --timeout 300 > "$OUT/ctest-gpu.txt" 2>&1; tail -4 "$OUT/ctest-gpu.txt")
-  log "ctest -L gpu: $(grep -E 'tests passed|tests failed' "$OUT/ctest-gpu.txt")"
+  # GPU_TESTS: a regular expression for a subset (default: every test labelled gpu).
+  (cd $B && ctest -L gpu ${GPU_TESTS:+-R "$GPU_TESTS"} --output-on-failure --timeout 300 > "$OUT/ctest-gpu.txt" 2>&1; tail -4 "$OUT/ctest-gpu.txt")
+  log "ctest -L gpu ${GPU_TESTS:-}: $(grep -E 'tests passed|tests failed' "$OUT/ctest-gpu.txt")"
 fi
 
 mpi() { "$MPIRUN" --oversubscribe --bind-to none "$@"; }
@@ -100,8 +109,27 @@ print(f"{same}/{len(h1)} GPU render benchmarks with one process's film hash over
 EOF_PY
 )"
 fi
+if has reduce; then
+  # The GPU ranks' reduction, NCCL against MPI (PATHBENCH_FILM_REDUCE=mpi), 2 GPU ranks,
+  # interleaved rounds (REPS, 3 here by default): frame and reduce seconds of each.
+  mkdir -p "$OUT/reduce"
+  for frame in "256 256 800" "2048 2048 1024"; do
+    set -- $frame
+    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2 --device gpu"
+    for i in $(seq 1 ${REDUCE_REPS:-3}); do
+      for how in nccl mpi; do
+        PATHBENCH_FILM_REDUCE=$how mpi -np 2 $PB $f --out "$OUT/r.pfm" --report "$OUT/reduce/$how-$1-$i.json"
+      done
+    done
+  done
+  rm -f "$OUT/r.pfm"
+  for p in "$OUT"/reduce/*.json; do
+    log "reduce $(basename "$p" .json): $(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['ranks']; print(f\"frame {r['frame_seconds']:.5f} s reduce {r['reduce_seconds']:.5f} s ({r['reduction']['gpu_ranks']}) parts\", [p.get('reduce_parts') for p in r['per_rank']][0])" "$p")"
+  done
+fi
 if has scaling; then
-  python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" --cpu-ranks 1,2,4 --reps 3 \
+  PYTHONUNBUFFERED=1 python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" \
+      --cpu-ranks "${CPU_RANKS-1,2,4}" --reps "${SCALING_REPS:-3}" --hybrid-rounds "${REPS:-5}" \
       --out-dir "$OUT/scaling" > "$OUT/scaling.txt" 2>&1
-  log "scaling: $(tail -3 "$OUT/scaling.txt" | tr '\n' ' ')"
+  log "scaling: $(grep -E '^\||NOT IDENTICAL' "$OUT/scaling.txt")"
 fi

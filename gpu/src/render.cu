@@ -71,6 +71,19 @@ double DeviceFilm::download(Film& film) const {
   return download_film(d.fb, film);
 }
 
+DeviceFilm::Arrays DeviceFilm::arrays() {
+  Impl& d = *impl_;
+  if (!d.used) throw std::logic_error("DeviceFilm::arrays: nothing was rendered into it");
+  return {d.fb.sum.get(), d.fb.count.get(), d.fb.sum_sq.get(), d.fb.count.size()};
+}
+
+uint64_t max_abs_sum_on_device(const unsigned long long* sums, uint64_t n);  // film_ops.cu
+uint64_t DeviceFilm::max_abs_sum() const {
+  const Impl& d = *impl_;
+  if (!d.used) throw std::logic_error("DeviceFilm::max_abs_sum: nothing was rendered into it");
+  return max_abs_sum_on_device(d.fb.sum.get(), d.fb.sum.size());
+}
+
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile) {
   // Start the context before measuring memory: its own use is not the tracer's.
   PB_CUDA_CHECK(cudaFree(nullptr));

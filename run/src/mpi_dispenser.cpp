@@ -28,6 +28,13 @@ struct SampleDispenser::Impl {
   bool aborted = false;
   uint64_t chunks = 0;
   std::vector<double> rates;
+  // Ranks whose rate is not measured yet: the units of their outstanding chunk and when
+  // it was granted. A rank still busy with it after t seconds runs at most units / t:
+  // that bound stands for its rate (not the others' mean), so a dominant rank (a GPU
+  // beside a slow CPU rank) is known as such from its own first chunk.
+  std::vector<bool> finished;  // ranks that have had their last grant (count 0)
+  std::vector<uint64_t> pending;
+  std::vector<std::chrono::steady_clock::time_point> granted_at;
   std::thread server;
   bool done = false;  // this rank has had its last grant (or quit)
 
@@ -35,18 +42,35 @@ struct SampleDispenser::Impl {
     std::lock_guard<std::mutex> lock(m);
     if (rate > 0) rates[size_t(rank)] = rate;
     if (aborted) return {next, 0};
-    // Ranks not measured yet count as the mean of the measured ones.
-    double known = 0;
-    int measured = 0;
-    for (double r : rates)
-      if (r > 0) known += r, ++measured;
-    const double total = measured ? known * double(rates.size()) / double(measured) : 0;
+    const auto now = std::chrono::steady_clock::now();
+    // The total rate: measured ranks' rates, and for the others the bound of their
+    // outstanding chunk (pending); ranks that have not asked yet count for nothing.
+    double total = 0;
+    bool measured = false;
+    for (size_t r = 0; r < rates.size(); ++r) {
+      if (rates[r] > 0) {
+        total += rates[r], measured = true;
+      } else if (r != size_t(rank) && pending[r] > 0) {
+        const double t = std::chrono::duration<double>(now - granted_at[r]).count();
+        total += t > 0 ? double(pending[r]) / t : 0.0;
+      }
+    }
+    if (!measured) total = 0;
     // One rank (no mpirun): the whole frame at once, as the one-rank build does.
-    const uint64_t count = world.size() == 1 ? units - next
-                                             : chunk_size(units - next, probe, rates[size_t(rank)], total);
+    uint64_t count = world.size() == 1 ? units - next : chunk_size(units - next, probe, rates[size_t(rank)], total);
+    // A measured rank gets a chunk only if it ends within the frame's projected end, unless
+    // it is the fastest of the ranks still taking chunks (who then takes it: the frame is
+    // always handed out): a CPU rank beside a GPU never makes the frame longer.
+    const double mine = rates[size_t(rank)];
+    bool faster_active = false;
+    for (size_t r = 0; r < rates.size(); ++r) faster_active |= r != size_t(rank) && !finished[r] && rates[r] > mine;
+    if (mine > 0 && total > 0 && count > 0 && faster_active && double(count) / mine > double(units - next) / total)
+      count = 0;
+    if (count == 0) finished[size_t(rank)] = true;
     const UnitRange s{next, count};
     next += count;
     if (count) ++chunks;
+    if (rates[size_t(rank)] <= 0) pending[size_t(rank)] = count, granted_at[size_t(rank)] = now;
     return s;
   }
 
@@ -77,8 +101,13 @@ struct SampleDispenser::Impl {
   }
 };
 
-SampleDispenser::SampleDispenser(World& world, uint64_t units) : impl_(std::make_unique<Impl>(world, units)) {
+SampleDispenser::SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates)
+    : impl_(std::make_unique<Impl>(world, units)) {
   impl_->rates.assign(size_t(world.size()), 0.0);
+  if (rates.size() == impl_->rates.size()) impl_->rates = rates;
+  impl_->pending.assign(size_t(world.size()), 0);
+  impl_->finished.assign(size_t(world.size()), false);
+  impl_->granted_at.resize(size_t(world.size()));
   if (world.root() && world.size() > 1) impl_->server = std::thread([this] { impl_->serve(); });
 }
 

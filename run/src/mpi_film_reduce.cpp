@@ -70,9 +70,7 @@ void World::reduce_film(Film& film) {
   for (int64_t v : film.raw_sums()) largest = std::max(largest, v < 0 ? uint64_t(0) - uint64_t(v) : uint64_t(v));
   std::vector<uint64_t> largest_all(size_t(size_), 0);
   MPI_Allgather(&largest, 1, MPI_UINT64_T, largest_all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
-  unsigned __int128 bound = 0;
-  for (uint64_t v : largest_all) bound += v;
-  const bool safe = bound <= (unsigned __int128)INT64_MAX;
+  const bool safe = sums_cannot_overflow(largest_all);
   MPI_Op checked = MPI_OP_NULL;
   if (!safe) MPI_Op_create(checked_sum, 1, &checked);
   reduce_to_root(film.raw_sums().data(), film.raw_sums().size(), MPI_INT64_T, safe ? MPI_SUM : checked, root());

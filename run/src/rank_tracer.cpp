@@ -118,4 +118,22 @@ void RankTracer::finish(Film& film, RunReport& report) {
 #endif
 }
 
+double RankTracer::calibrate(const FrameBlock& block, Film& film, float max_emission) {
+  RunReport probe;
+  trace(block, film, probe);
+  chunks_ = 0;  // the frame's first block describes the rank
+#if PATHBENCH_HAVE_CUDA
+  if (gpu_) gpu_->film.clear();
+#endif
+  if (!gpu_) film.begin(settings_.spp, max_emission);
+  return probe.seconds;
+}
+
+gpu::DeviceFilm* RankTracer::device_film() {
+#if PATHBENCH_HAVE_CUDA
+  if (gpu_ && gpu_->film.used()) return &gpu_->film;
+#endif
+  return nullptr;
+}
+
 }  // namespace pb::run

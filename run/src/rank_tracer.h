@@ -10,6 +10,10 @@
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 
+namespace pb::gpu {
+class DeviceFilm;
+}
+
 namespace pb::run {
 
 class RankTracer {
@@ -30,8 +34,15 @@ class RankTracer {
   // Before the frame's clock starts (film sized and begun): a GPU rank's warm-up, as one
   // GPU process warms up before its timed frame. Nothing on the CPU.
   void warm_up(Film& film);
+  // Before the frame's clock starts (after warm_up): traces `block` as a probe and returns
+  // its seconds, leaving the film (host and device) cleared and this tracer as if it had
+  // traced nothing: dynamic balancing then starts from every rank's measured rate.
+  double calibrate(const FrameBlock& block, Film& film, float max_emission);
   // After the rank's last block: a GPU rank's film comes back from the device (once).
   void finish(Film& film, RunReport& report);
+  // A GPU rank's film on the device (what finish() downloads), for a reduction on the
+  // GPUs; null on a CPU rank or before the first block.
+  gpu::DeviceFilm* device_film();
 
  private:
   const Scene& scene_;

@@ -1,6 +1,7 @@
 #include "pathbench/run/ranks.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -74,6 +75,12 @@ bool add_rows_into(Film& into, uint32_t first_row, uint32_t rows, const int64_t*
   return ok;
 }
 
+bool sums_cannot_overflow(const std::vector<uint64_t>& largest) {
+  unsigned __int128 bound = 0;
+  for (uint64_t v : largest) bound += v;
+  return bound <= (unsigned __int128)INT64_MAX;
+}
+
 void reduce_film(Film& into, const Film& part) {
   if (into.width() != part.width() || into.height() != part.height() || into.scale() != part.scale() ||
       into.has_variance() != part.has_variance())
@@ -95,6 +102,11 @@ uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double tota
   // Never less than the probe: below it a GPU's call costs more than its samples (a
   // partly idle device, a launch, a sync), so the last crumbs go in one chunk.
   const double share = rate > 0 && total_rate > 0 ? std::min(1.0, rate / total_rate) : 0.0;
+  // A rank with nearly all of the rate (the others together under 2 %: a GPU beside CPU
+  // ranks) takes all that is left: the others could save at most that share of the frame,
+  // less than a further call costs the dominant device, and their probes end within its
+  // frame. So a hybrid frame is never slower than the GPU alone (issue 30).
+  if (share >= kDominantShare) return remaining;
   const double least = double(std::max<uint64_t>(probe, 1));
   const double want = share > 0 ? std::max(std::ceil((0.75 + 0.2 * share) * share * double(remaining)), least) : least;
   return uint64_t(std::min<double>(want, double(remaining)));

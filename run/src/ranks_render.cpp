@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include "pathbench/run/ranks_report.h"
 #include "pathbench/run/run_context.h"
 #include "pathbench/run/world.h"
+#include "gpu_reduce.h"
 #include "rank_tracer.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/render.h"
@@ -153,11 +155,41 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     balance = std::all_of(devices.begin(), devices.end(), [&](const auto& d) { return d == devices[0]; })
                   ? Balance::Static : Balance::Dynamic;
   if (!w.can_dispense()) balance = Balance::Static;
+  // How the films come together: GPU ranks through NCCL where they can (gpu_reduce.h),
+  // the rest through MPI. Set up (communicator, page-locked film on the GPU root) before
+  // the frame's clock starts.
+  GpuReduction gred;
+  on_every_rank([&] { gred = prepare_gpu_reduction(w, s.device == Device::Gpu, gpu_index); });
+  const bool cpu_ranks = std::find(devices.begin(), devices.end(), "cpu") != devices.end();
+  // MPI has nothing left to add where NCCL brought every film to rank 0.
+  const bool mpi_after_nccl = cpu_ranks || gred.root != 0;
+  // A GPU rank that downloads a film it keeps (NCCL's root, or every GPU rank without NCCL)
+  // downloads into page-locked memory.
+  PinnedFilm pinned(film, s.device == Device::Gpu && (!gred.nccl || w.rank() == gred.root));
+  on_every_rank([&] { warm_gpu_reduction(gred, tracer->device_film()); });
+  // Dynamic balancing: a rank's probe chunk measures its rate: ~2 M samples fill a GPU (an
+  // H100 runs ~270 k threads at once), 64 per thread keep a CPU rank's short. Each rank
+  // traces one before the frame's clock starts (as it warms up), and every rank's rate
+  // seeds the dispenser, so the first grants already follow the rates: a GPU that does
+  // nearly all of the work takes the frame in one chunk.
+  const uint64_t probe_samples = s.device == Device::Gpu ? uint64_t(1) << 21 : uint64_t(std::max(1, s.threads)) * 64;
+  const uint64_t probe = std::max<uint64_t>(1, (probe_samples + s.width - 1) / s.width);
+  std::vector<double> rates;
+  if (balance == Balance::Dynamic) {
+    double rate = 0;
+    on_every_rank([&] {
+      const uint64_t n = std::min<uint64_t>(probe, uint64_t(s.height) * s.spp);
+      double seconds = 0;
+      for (const FrameBlock& b : blocks_of({0, n}, s.spp, s.height)) seconds += tracer->calibrate(b, film, scene.max_emission());
+      rate = seconds > 0 ? double(n) / seconds : 0.0;
+    });
+    for (const std::string& r : w.all(fmt::format("{:a}", rate))) rates.push_back(std::strtod(r.c_str(), nullptr));
+  }
 
   // 3. The frame: from a common start to the reduced film on rank 0.
+  const nlohmann::json load0 = load_sample();
   w.barrier();
   const Clock::time_point t0 = Clock::now();
-  const nlohmann::json load0 = load_sample();
   RunReport mine;
   RankFailure failed;
   uint64_t samples = 0;           // (pixel, sample) pairs this rank traced
@@ -172,17 +204,13 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   {
     // Dynamic balancing only: rank 0 then serves it (its units: rows x samples).
     std::optional<SampleDispenser> dispenser;
-    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp);
+    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
     try {
       if (balance == Balance::Static) {
         const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
         if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
-        // A rank's first chunk measures its rate: ~2 M samples fill a GPU (an H100 runs
-        // ~270 k threads at once), a few hundred per thread keep a CPU rank's probe short.
-        const uint64_t probe_samples = s.device == Device::Gpu ? uint64_t(1) << 21 : uint64_t(s.threads) * 256;
-        const uint64_t probe = std::max<uint64_t>(1, (probe_samples + s.width - 1) / s.width);
-        double rate = 0;  // units per second in the last chunk
+        double rate = rates.empty() ? 0.0 : rates[size_t(w.rank())];  // units per second in the last chunk
         for (;;) {
           const UnitRange range = dispenser->next(rate, probe);
           if (range.count == 0) break;
@@ -192,7 +220,6 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
           ++chunks;
         }
       }
-      tracer->finish(film, mine);
     } catch (...) {
       failed = failure_of(std::current_exception(), w.rank());
       if (dispenser) dispenser->abort();
@@ -203,15 +230,44 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   }
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
-  // A static split's ranks each hold every pixel (MPI_Reduce); dynamic chunks' ranks hold
-  // bands of rows, and only those travel.
-  on_every_rank([&] { balance == Balance::Dynamic ? w.reduce_film_rows(film, rows) : w.reduce_film(film); });
+  const double wait_seconds = std::chrono::duration<double>(r0 - t0).count() - mine.seconds;
+  double bound_seconds = 0, nccl_seconds = 0, download_seconds = 0, mpi_seconds = 0;
+  bool by_nccl = false;
+  on_every_rank([&] {
+    // GPU ranks: added on the GPUs onto the lowest GPU rank, which alone downloads the sum.
+    by_nccl = reduce_gpu_films(w, gred, tracer->device_film(), bound_seconds, nccl_seconds);
+    const Clock::time_point d0 = Clock::now();
+    if (!by_nccl || w.rank() == gred.root) tracer->finish(film, mine);  // GPU ranks: the download
+    download_seconds = since(d0);
+    const Clock::time_point m0 = Clock::now();
+    if (by_nccl && !mpi_after_nccl) return;
+    if (by_nccl) {
+      // The GPU ranks' sum, on gred.root, travels to rank 0 as rows, with the CPU ranks' rows.
+      std::vector<RowRange> send = rows;
+      if (s.device == Device::Gpu) send = w.rank() == gred.root ? std::vector<RowRange>{{0, s.height}}
+                                                                : std::vector<RowRange>{};
+      else if (balance == Balance::Static) send = {{0, s.height}};
+      w.reduce_film_rows(film, send);
+    } else {
+      // A static split's ranks each hold every pixel (MPI_Reduce); dynamic chunks' ranks hold
+      // bands of rows, and only those travel.
+      balance == Balance::Dynamic ? w.reduce_film_rows(film, rows) : w.reduce_film(film);
+    }
+    mpi_seconds = since(m0);
+  });
   const double reduce_seconds = since(r0), frame_seconds = since(t0);
 
   // 4. One report, on rank 0.
   mine.peak_host_bytes = peak_resident_bytes();
-  const std::vector<std::string> ranks = w.gather(
-      rank_entry(w.rank(), w.host(), s, mine, gpu_index, samples, chunks, busy_wall).dump());
+  nlohmann::json entry = rank_entry(w.rank(), w.host(), s, mine, gpu_index, samples, chunks, busy_wall);
+  // Where this rank's frame went: tracing (its tracer calls), waiting (chunk requests, the
+  // slowest rank), and the reduction (bound check, NCCL, the download, MPI).
+  entry["trace_seconds"] = mine.seconds;
+  entry["wait_seconds"] = std::max(0.0, wait_seconds);
+  entry["reduce_seconds"] = reduce_seconds;
+  entry["reduce_parts"] = {{"overflow_bound", bound_seconds}, {"nccl", nccl_seconds},
+                           {"download", download_seconds}, {"mpi", mpi_seconds}};
+  const std::vector<std::string> ranks = w.gather(entry.dump());
   on_every_rank([&] {
     if (!w.root()) return;
     report = mine;
@@ -223,6 +279,10 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     report.fingerprint = run_fingerprint(s.device == Device::Gpu);
     merge_ranks(report, ranks, frame_seconds, reduce_seconds, balance == Balance::Dynamic ? "dynamic" : "static");
     if (balance == Balance::Dynamic) report.extra["ranks"]["chunks_granted"] = granted;
+    report.extra["ranks"]["reduction"] = {
+        {"gpu_ranks", by_nccl ? "nccl" : "mpi"}, {"why", gred.why},
+        {"nccl_version", gred.nccl_version.empty() ? nlohmann::json(nullptr) : nlohmann::json(gred.nccl_version)},
+        {"share_of_frame", frame_seconds > 0 ? reduce_seconds / frame_seconds : 0.0}};
     check_discarded(scene, settings, report);
     report.extra["film_hash"] = film_hash(film);  // the reduced film's: the same as one process's
   });

@@ -268,6 +268,31 @@ TEST(DeviceFilm, BlocksAddUpToTheWholeFrame) {
   }
 }
 
+// What run/'s NCCL reduction reads of a device film (issue 30): its arrays on the device,
+// and the largest |sum|, the same as the downloaded film's.
+TEST(DeviceFilm, ArraysAndLargestSum) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  const GpuScene gpu_scene(scene);
+  const RenderSettings s = small_settings(Strategy::Pixel, 40, 8);
+  Film film(s.width, s.height, false);
+  film.begin(s.spp, scene.max_emission());
+  DeviceFilm device_film;
+  EXPECT_THROW(device_film.arrays(), std::logic_error);
+  RunReport r;
+  render(scene, gpu_scene, s, film, r, false, &device_film);
+  const DeviceFilm::Arrays a = device_film.arrays();
+  EXPECT_EQ(a.pixels, uint64_t(s.width) * s.height);
+  EXPECT_NE(a.sums, nullptr);
+  EXPECT_NE(a.counts, nullptr);
+  EXPECT_EQ(a.sum_sq, nullptr);
+  device_film.download(film);
+  uint64_t largest = 0;
+  for (int64_t v : film.raw_sums()) largest = std::max<uint64_t>(largest, v < 0 ? uint64_t(0) - uint64_t(v) : uint64_t(v));
+  EXPECT_GT(largest, 0u);
+  EXPECT_EQ(device_film.max_abs_sum(), largest);
+}
+
 TEST(GpuVsCpu, PaperCornell) {
   PB_REQUIRE_GPU();
   gpu_vs_cpu("paper-cornell");

@@ -13,6 +13,13 @@
 #                 iteration is a frame over both ranks, with one process's film hashes
 # gpu2, hybrid    (CUDA builds; skipped, status 77, without a usable GPU) 2 GPU ranks, and
 #                 --device hybrid (GPU + CPU ranks, dynamic), give the one-GPU image
+# gpu_shared      (CUDA builds; skipped without a GPU) 3 GPU ranks on the visible GPUs, more
+#                 ranks than GPUs where there are fewer than 3: the one-GPU image; the report
+#                 says how the GPU ranks' films were reduced (NCCL or MPI, and why)
+# tcp             as between nodes: MPI's TCP transport alone (--mca btl self,tcp, no shared
+#                 memory), static and dynamic: the one-process image byte for byte
+# tcp_killed_rank a rank SIGKILLed over TCP alone: the run ends within 30 s with a message
+#                 naming the lost process, no image
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -44,7 +51,39 @@ refused() {  # STATUS-WANTED REGEX FILE
   return 0
 }
 
+# Rank 1 is a shell that starts pathbench (which joins the run as rank 1) and kills it: the
+# run ends within 30 s, non-zero, naming the killed process, with no image. $@: mpirun options.
+killed() {
+  start=$(date +%s)
+  run "$@" -np 1 "$pb" $base --spp 100000 --out x.pfm : \
+      -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
+  elapsed=$(( $(date +%s) - start ))
+  [ "$status" != 0 ] || fail "the run succeeded"
+  [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
+  [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
+  grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
+  refused "$status" "." x.pfm
+}
+# Between nodes there is no shared memory: TCP alone, on the loopback interface here.
+tcp="--mca btl self,tcp --mca btl_tcp_if_include lo --mca pml ob1 --mca osc ^sm,rdma"
+
 case $case_name in
+  tcp)
+    one
+    for balance in static dynamic; do
+      run $tcp -np 2 "$pb" $frame --balance $balance --out $balance.pfm --report $balance.json
+      [ "$status" = 0 ] || { cat err.txt >&2; fail "TCP only, --balance $balance: status $status"; }
+      same $balance.pfm
+      [ "$(film_hash one.json)" = "$(film_hash $balance.json)" ] || fail "TCP only: film_hash differs"
+    done ;;
+  tcp_killed_rank) killed $tcp ;;
+  gpu_shared)
+    "$pb" $frame --device gpu --out gpu.pfm --report gpu.json 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
+    run -np 3 "$pb" $frame --device gpu --out x.pfm --report x.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    cmp -s gpu.pfm x.pfm || fail "3 GPU ranks: x.pfm differs from the one-GPU image"
+    [ "$(film_hash gpu.json)" = "$(film_hash x.json)" ] || fail "3 GPU ranks: film_hash differs"
+    grep -q '"gpu_ranks": "\(nccl\|mpi\)"' x.json || fail "the report does not say how the films were reduced" ;;
   np2|np3)
     n=${case_name#np}
     one
@@ -71,17 +110,7 @@ case $case_name in
   hybrid_no_gpu)
     run -np 2 "$pb" $frame --device hybrid --out x.pfm
     refused 2 "rank 0 of 2: --device gpu: " x.pfm ;;
-  killed_rank)
-    start=$(date +%s)
-    # Rank 1 is a shell that starts pathbench (which joins the run as rank 1) and kills it.
-    run -np 1 "$pb" $base --spp 100000 --out x.pfm : \
-        -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
-    elapsed=$(( $(date +%s) - start ))
-    [ "$status" != 0 ] || fail "the run succeeded"
-    [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
-    [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
-    grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
-    refused "$status" "." x.pfm ;;
+  killed_rank) killed ;;
   accuracy)
     "$pb" accuracy --quick --no-report-tool --out-dir one >one.log 2>&1 || { cat one.log >&2; fail "one process failed"; }
     run -np 2 "$pb" accuracy --quick --no-report-tool --out-dir two

@@ -140,8 +140,9 @@ TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
   EXPECT_EQ(run::chunk_size(500, 12, 1.0, 1000.0), 12u);
   EXPECT_EQ(run::chunk_size(500, 0, 1.0, 1000.0), 1u);
   EXPECT_EQ(run::chunk_size(0, 12, 1.0, 1.0), 0u);
-  // Beyond 32 bits (a 65536-row frame at 2^17 spp).
-  EXPECT_EQ(run::chunk_size(uint64_t(1) << 33, 12, 1.0, 1.0), uint64_t(0.95 * double(uint64_t(1) << 33)) + 1);
+  // Beyond 32 bits (a 65536-row frame at 2^17 spp), a rank of half the rate. (A rank of all
+  // of it takes everything: ADominantRankTakesTheRest.)
+  EXPECT_EQ(run::chunk_size(uint64_t(1) << 33, 12, 1.0, 2.0), uint64_t(0.425 * double(uint64_t(1) << 33)) + 1);
   // A GPU 30x a CPU, each asking when its chunk would end: the frame is covered exactly,
   // the GPU needs few chunks, and the CPU's work ends no later than the GPU's.
   const double rate[2] = {30.0, 1.0};
@@ -158,6 +159,26 @@ TEST(RankSplit, ChunksFollowTheRateAndCoverTheFrame) {
   EXPECT_EQ(next, 1024u);
   EXPECT_LE(chunks[0], 6u);
   EXPECT_LE(busy_until[1], busy_until[0] * 1.05);
+}
+
+// Issue 30: a rank with >= 98 % of the total rate (a GPU beside a slow CPU rank) takes all
+// that is left in one chunk, so the hybrid's GPU makes one more call at most, not a tail of
+// shrinking chunks; just under the threshold the share rule still applies.
+TEST(RankSplit, ADominantRankTakesTheRest) {
+  EXPECT_EQ(run::chunk_size(204800, 8192, 99.0, 100.0), 204800u);
+  EXPECT_EQ(run::chunk_size(204800, 8192, run::kDominantShare, 1.0), 204800u);
+  EXPECT_LT(run::chunk_size(204800, 8192, 97.0, 100.0), 204800u);
+}
+
+// The bound under which the MPI and NCCL reductions add int64 sums unchecked (issue 30).
+TEST(RankSplit, SumsCannotOverflowBound) {
+  const uint64_t max = uint64_t(INT64_MAX);
+  EXPECT_TRUE(run::sums_cannot_overflow({}));
+  EXPECT_TRUE(run::sums_cannot_overflow({max}));
+  EXPECT_TRUE(run::sums_cannot_overflow({max - 5, 5, 0}));
+  EXPECT_FALSE(run::sums_cannot_overflow({max - 5, 6}));
+  EXPECT_FALSE(run::sums_cannot_overflow({max, max, max, max}));  // no wrap in the bound's own sum
+  EXPECT_FALSE(run::sums_cannot_overflow({uint64_t(1) << 63}));   // |INT64_MIN|
 }
 
 TEST(RankSplit, OneProcessIsOneRank) {

@@ -79,6 +79,21 @@ class DeviceFilm {
   // Replaces `film`'s sums and counts (and variance sums) with the device's: the sums of
   // every render into it. Returns the seconds the copy took.
   double download(Film& film) const;
+  // Its arrays on the device, for a collective that reads and adds them in place (run/'s
+  // NCCL reduction of MPI ranks' films): device pointers on this process's current
+  // device, valid while the film lives. `sums` holds Film's int64 sums (two's complement),
+  // 3 per pixel; `counts` uint32, one per pixel; `sum_sq` doubles, 3 per pixel, or null.
+  // Throws std::logic_error before the first render into it.
+  struct Arrays {
+    void* sums = nullptr;
+    void* counts = nullptr;
+    void* sum_sq = nullptr;
+    uint64_t pixels = 0;
+  };
+  Arrays arrays();
+  // The largest |sum| of any pixel's channel, read on the device: the bound a reduction
+  // of several films checks before it adds them without overflow checks.
+  uint64_t max_abs_sum() const;
   struct Impl;
   Impl& impl() { return *impl_; }
 

@@ -58,6 +58,11 @@ template <class T> bool add_values(T* into, const T* add, size_t n) {
   return ok;
 }
 
+// Whether films whose largest |sums| are `largest` (one value per rank) add up without
+// overflow in any order: their total is at most 2^63 - 1, which bounds every partial sum.
+// The MPI (MPI_SUM) and NCCL (ncclSum) reductions add unchecked only where it holds.
+bool sums_cannot_overflow(const std::vector<uint64_t>& largest);
+
 // Adds `part`'s sums, counts and variance sums into `into` (same size, same scale: both
 // begun for the whole frame). Integer sums: exact and order-free. Throws
 // std::invalid_argument when the films do not match, std::overflow_error when a sum

@@ -99,8 +99,12 @@ int launcher_rank();
 // Every rank constructs it and calls finish(); next() and abort() are per rank.
 class SampleDispenser {
  public:
-  // `units`: the frame's (rows x spp).
-  SampleDispenser(World& world, uint64_t units);
+  // `units`: the frame's (rows x spp). `rates`: every rank's units per second as measured
+  // before the frame (a probe chunk each, RankTracer::calibrate), in rank order, or empty:
+  // then the first grants are probes. A rank whose chunk would outlast the frame's
+  // projected end (what is left / the ranks' total rate) gets none, unless it is the
+  // fastest: a slow rank never holds the frame up.
+  SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates = {});
   ~SampleDispenser();
   SampleDispenser(const SampleDispenser&) = delete;
   SampleDispenser& operator=(const SampleDispenser&) = delete;
@@ -125,6 +129,8 @@ class SampleDispenser {
 // `rate` among ranks of total rate `total_rate` (rates of ranks not measured yet counted
 // as the mean of the measured ones by the caller); `probe` units while its rate is
 // unknown, and never less than that (the last crumbs go to whoever asks first).
+// A rank of at least kDominantShare of the total rate gets all that is left.
 uint64_t chunk_size(uint64_t remaining, uint64_t probe, double rate, double total_rate);
+constexpr double kDominantShare = 0.98;
 
 }  // namespace pb::run
