@@ -13,7 +13,7 @@
 #include "film_agreement.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_facts.h"
-#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 

@@ -13,8 +13,8 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/bvh_layout.h"
 #include "traversal_check.h"
 
 namespace pb::gpu {

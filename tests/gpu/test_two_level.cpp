@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 
 namespace pb::gpu {
 namespace {

@@ -13,7 +13,7 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/bvh/bvh.h"
 
 namespace pb::gpu::test {
 

@@ -9,7 +9,7 @@
 
 #include "embree_rays.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 
 namespace pb::cpu {
 namespace {

@@ -17,8 +17,8 @@
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/isa.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/run/run.h"
 
 namespace pb {

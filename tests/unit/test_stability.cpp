@@ -21,7 +21,7 @@
 #include "stability_device.h"
 #include "stat_test.h"
 #ifdef PB_STABILITY_ON_GPU
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/bvh/bvh.h"
 #endif
 
 namespace pb {

@@ -1,4 +1,4 @@
-#include "pathbench/gpu/wide_bvh_build.h"
+#include "pathbench/bvh/wide_bvh_build.h"
 
 #include <fmt/core.h>
 

@@ -1,4 +1,4 @@
-#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/bvh/host_tracer.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -8,7 +8,7 @@
 #include <chrono>
 
 #include "pathbench/common/features.h"
-#include "pathbench/gpu/path_trace.h"
+#include "pathbench/bvh/path_trace.h"
 
 namespace pb::gpu {
 

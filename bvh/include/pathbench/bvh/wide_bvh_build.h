@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/wide_bvh.h"
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/wide_bvh.h"
 
 namespace pb::gpu {
 

@@ -13,7 +13,7 @@
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 
 namespace pb::gpu {
 

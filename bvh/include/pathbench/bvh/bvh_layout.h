@@ -20,10 +20,10 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/traversal.h"
-#include "pathbench/gpu/two_level_build.h"
-#include "pathbench/gpu/wide_bvh_build.h"
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/traversal.h"
+#include "pathbench/bvh/two_level_build.h"
+#include "pathbench/bvh/wide_bvh_build.h"
 
 namespace pb::gpu {
 

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/two_level_bvh.h"
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/two_level_bvh.h"
 
 namespace pb::gpu {
 

@@ -1,4 +1,4 @@
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 
 #include <fmt/core.h>
 

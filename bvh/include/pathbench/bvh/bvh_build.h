@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh.h"
-#include "pathbench/gpu/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
+#include "pathbench/bvh/bvh.h"
+#include "pathbench/bvh/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
 
 namespace pb::gpu {
 

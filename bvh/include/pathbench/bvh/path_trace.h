@@ -8,7 +8,7 @@
 
 #include "pathbench/common/hd.h"
 #include "pathbench/common/path.h"
-#include "pathbench/gpu/traversal.h"
+#include "pathbench/bvh/traversal.h"
 
 namespace pb::gpu {
 

@@ -16,7 +16,7 @@
 
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/bvh/bvh.h"
 
 // The per-node loops must unroll on the device: their small arrays then live in
 // registers, not in local memory.

@@ -9,11 +9,11 @@
 #include <type_traits>
 
 #include "pathbench/common/hd.h"
-#include "pathbench/gpu/brute_force.h"
-#include "pathbench/gpu/bvh.h"
-#include "pathbench/gpu/leaf_list.h"
-#include "pathbench/gpu/two_level_bvh.h"
-#include "pathbench/gpu/wide_bvh.h"
+#include "pathbench/bvh/brute_force.h"
+#include "pathbench/bvh/bvh.h"
+#include "pathbench/bvh/leaf_list.h"
+#include "pathbench/bvh/two_level_bvh.h"
+#include "pathbench/bvh/wide_bvh.h"
 
 namespace pb::gpu {
 

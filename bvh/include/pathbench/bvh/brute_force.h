@@ -7,7 +7,7 @@
 
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/bvh/bvh.h"
 
 namespace pb::gpu {
 

@@ -1,4 +1,4 @@
-#include "pathbench/gpu/bvh_build.h"
+#include "pathbench/bvh/bvh_build.h"
 
 #include <embree3/rtcore.h>
 #include <fmt/core.h>
