@@ -10,7 +10,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 namespace {
 constexpr struct {
@@ -184,4 +184,4 @@ nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, In
       .to_json();
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

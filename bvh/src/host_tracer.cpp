@@ -10,7 +10,7 @@
 #include "pathbench/common/features.h"
 #include "pathbench/bvh/path_trace.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 HostGpuTracer::HostGpuTracer(const Scene& scene, Instancing instancing)
     : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env(instancing))) {}
@@ -61,4 +61,4 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   report.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -8,7 +8,7 @@
 #include <chrono>
 #include <cmath>
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 namespace {
 
@@ -164,4 +164,4 @@ TwoLevelHost build_two_level_bvh(const Scene& s, const BvhBuildOptions& options)
   return out;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

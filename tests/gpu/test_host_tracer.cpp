@@ -17,7 +17,7 @@
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 namespace {
 
 RenderSettings settings(uint32_t size, uint32_t spp) {
@@ -108,4 +108,4 @@ TEST(HostGpuTracerSlow, PaperFrameWithinAcceptance) {
 }
 
 }  // namespace
-}  // namespace pb::gpu
+}  // namespace pb::bvh

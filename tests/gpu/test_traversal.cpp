@@ -17,7 +17,7 @@
 #include "pathbench/bvh/bvh_layout.h"
 #include "traversal_check.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 namespace {
 
 using test::Agreement;
@@ -436,4 +436,4 @@ TEST(WideBvh, QuantisedBoxesHoldTheirTriangles) {
 }
 
 }  // namespace
-}  // namespace pb::gpu
+}  // namespace pb::bvh

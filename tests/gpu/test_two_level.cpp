@@ -14,7 +14,7 @@
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/host_tracer.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 namespace {
 
 const std::string kRoot = std::string(PATHBENCH_SOURCE_DIR) + "/";
@@ -159,4 +159,4 @@ TEST(TwoLevel, FollowsARebasedScene) {
 }
 
 }  // namespace
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -9,7 +9,7 @@
 #include "pathbench/common/math.h"
 #include "pathbench/bvh/bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 // Closest hit (kAnyHit = false) or any hit among tris[0..n), as traverse() in bvh.h:
 // same triangle test, so the same answer (of two triangles at exactly the same t, the
@@ -29,4 +29,4 @@ PB_HD uint32_t traverse_all(const BvhTriangle* tris, uint32_t n, const Vec3f& o,
   return detail::finish_closest<kWatertight>(tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

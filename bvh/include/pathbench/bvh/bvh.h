@@ -10,8 +10,9 @@
 #include "pathbench/common/math.h"
 #include "pathbench/common/moller_trumbore.h"
 #include "pathbench/common/watertight.h"
+#include "pathbench/bvh/gpu_names.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 // Child reference: an inner node's index, or a leaf (top bit set) holding up to
 // kMaxLeafPrims consecutive triangles from `first`.
@@ -338,4 +339,4 @@ PB_HD bool occluded(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, fl
   return traverse<true, kWatertight>(bvh, o, d, t_max, t) != kNoHit;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

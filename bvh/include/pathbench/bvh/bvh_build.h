@@ -9,7 +9,7 @@
 #include "pathbench/bvh/bvh.h"
 #include "pathbench/bvh/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 struct BvhBuildOptions {
   unsigned max_leaf_size = 4;     // <= kMaxLeafPrims
@@ -35,4 +35,4 @@ struct BvhHost {
 
 BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options = {});
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -25,7 +25,7 @@
 #include "pathbench/bvh/two_level_build.h"
 #include "pathbench/bvh/wide_bvh_build.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6 };
 
@@ -91,4 +91,4 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options);
 // structure's bytes and build time (report.extra["instancing"], GPU and HostGpuTracer).
 nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, Instancing asked);
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

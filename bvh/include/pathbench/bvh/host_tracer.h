@@ -15,7 +15,7 @@
 #include "pathbench/common/settings.h"
 #include "pathbench/bvh/bvh_layout.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 class HostGpuTracer {
  public:
@@ -36,4 +36,4 @@ class HostGpuTracer {
   SceneBvhHost bvh_;
 };
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -17,7 +17,7 @@
 #include "pathbench/common/math.h"
 #include "pathbench/bvh/bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 // One leaf: its box and its triangles (make_leaf_ref(first, count)), two 16-byte loads.
 struct alignas(16) LeafBox {
@@ -119,4 +119,4 @@ PB_HD uint32_t traverse_leaves(const LeafListView& f, const Vec3f& o, const Vec3
   return detail::finish_closest<kWatertight>(f.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -10,7 +10,7 @@
 #include "pathbench/common/path.h"
 #include "pathbench/bvh/traversal.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -55,4 +55,4 @@ PB_HD Vec3f trace_path_bvh(const SceneView& s, const BvhView& bvh, const PathCon
   return Vec3f(st.L);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

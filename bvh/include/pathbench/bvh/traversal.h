@@ -15,7 +15,7 @@
 #include "pathbench/bvh/two_level_bvh.h"
 #include "pathbench/bvh/wide_bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 // Binary: bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
 // brute_force.h, the triangles in scene order in `tris` and no nodes. TwoLevel:
@@ -97,4 +97,4 @@ decltype(auto) with_traversal_kind(const BvhView& bvh, Fn&& fn) {
   }
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

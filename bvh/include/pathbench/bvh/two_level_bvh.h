@@ -20,7 +20,7 @@
 #include "pathbench/common/scene.h"
 #include "pathbench/bvh/bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 struct alignas(16) TwoLevelInstance {
   float inv[12];            // row-major 3x4: traced (world) coordinates -> the prototype's
@@ -100,4 +100,4 @@ PB_HD uint32_t traverse_two_level(const TwoLevelView& v, const Vec3f& o, const V
   return hit;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -26,7 +26,7 @@
 #define PB_WIDE_UNROLL
 #endif
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 constexpr uint32_t kWideMaxChildren = 8;
 constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
@@ -206,4 +206,4 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh
