@@ -7,8 +7,8 @@
 #include <atomic>
 #include <chrono>
 
-#include "pathbench/common/features.h"
 #include "pathbench/bvh/path_trace.h"
+#include "pathbench/common/features.h"
 
 namespace pb::bvh {
 

@@ -9,11 +9,11 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
 #include "pathbench/bvh/bvh_build.h"
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/host_tracer.h"
+#include "pathbench/common/errors.h"
+#include "pathbench/common/scene_library.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "film_agreement.h"

@@ -11,9 +11,9 @@
 #include <string>
 
 #include "film_agreement.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_facts.h"
-#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 

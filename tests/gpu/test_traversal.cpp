@@ -11,10 +11,10 @@
 #include <random>
 #include <string>
 
-#include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
 #include "pathbench/bvh/bvh_build.h"
 #include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/common/errors.h"
+#include "pathbench/common/scene_library.h"
 #include "traversal_check.h"
 
 namespace pb::bvh {

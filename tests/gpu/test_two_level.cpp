@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "pathbench/common/scene_library.h"
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/host_tracer.h"
+#include "pathbench/common/scene_library.h"
 
 namespace pb::bvh {
 namespace {

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/bvh/bvh.h"
 
 namespace pb::bvh::test {
 

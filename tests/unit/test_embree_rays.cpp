@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "embree_rays.h"
-#include "pathbench/common/scene_library.h"
 #include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/common/scene_library.h"
 
 namespace pb::cpu {
 namespace {

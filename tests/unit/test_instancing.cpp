@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/isa.h"
-#include "pathbench/bvh/bvh_layout.h"
-#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/run/run.h"
 
 namespace pb {

@@ -21,7 +21,7 @@
 #include "stability_device.h"
 #include "stat_test.h"
 #ifdef PB_STABILITY_ON_GPU
-#include "pathbench/bvh/bvh.h"
+#include "pathbench/bvh/hit_tests.h"
 #endif
 
 namespace pb {

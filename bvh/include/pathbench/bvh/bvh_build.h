@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "pathbench/common/scene.h"
-#include "pathbench/bvh/bvh.h"
+#include "pathbench/bvh/binary_bvh.h"
 #include "pathbench/bvh/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
+#include "pathbench/common/scene.h"
 
 namespace pb::bvh {
 

@@ -5,15 +5,15 @@
 // bit; the price is speed (this traversal is plain C++, far slower than Embree's). For a
 // CPU working beside GPUs on one frame (the hybrid CPU+GPU render, run/'s RankTracer):
 // then the frame's image is one GPU's whichever device took which samples. In every
-// build, with or without CUDA (pathbench::gpu_bvh).
+// build, with or without CUDA (pathbench::bvh).
 #include <cstdint>
 #include <string>
 
+#include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
-#include "pathbench/bvh/bvh_layout.h"
 
 namespace pb::bvh {
 

@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <limits>
 
+#include "pathbench/bvh/traversal.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/path.h"
-#include "pathbench/bvh/traversal.h"
 
 namespace pb::bvh {
 

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "pathbench/common/scene.h"
 #include "pathbench/bvh/bvh_build.h"
 #include "pathbench/bvh/two_level_bvh.h"
+#include "pathbench/common/scene.h"
 
 namespace pb::bvh {
 
