@@ -104,7 +104,7 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
 // kExact: the view's exact_ties read at run time (-1), or known at compile time (0, 1):
 // the hot kernels are compiled for one or the other, since a run-time flag keeps the tie
 // compare's registers live in every kernel (ptxas, sm_90, k_pixel: 48 -> 60 bytes of
-// spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (gpu/NOTES.md).
+// spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (docs/notes/gpu-log.md).
 template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
 PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {

@@ -84,7 +84,7 @@ PB_HD float safe_inverse(float d) {
 // whose computed t is <= the best t is then computed in full and compared, and the
 // answer depends on the triangles alone, not on the order they come in. Without it (a
 // scene without instances) a triangle is tested against the best t and wins if it hits,
-// as before instancing existed, so those scenes keep their images (gpu/NOTES.md).
+// as before instancing existed, so those scenes keep their images (docs/notes/gpu-log.md).
 constexpr float kTieSlack = 1.0f + 0x1p-20f;
 PB_HD bool closer(float tt, uint32_t prim, float t, uint32_t hit) { return tt < t || (tt == t && prim < hit); }
 
