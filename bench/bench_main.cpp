@@ -35,7 +35,7 @@
 #include "bench_ranks.h"
 #include "pathbench/run/world.h"
 #if PATHBENCH_BENCH_GPU
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 #endif
 #include "materials_bench.h"
 #include "raycast_bench.h"

@@ -27,7 +27,7 @@
 namespace pb::cpu {
 class EmbreeScene;
 }
-namespace pb::gpu {
+namespace pb::bvh {
 enum class GpuBvhLayout : uint32_t;
 }
 
@@ -53,8 +53,8 @@ struct RaycastCase {
 void register_raycast_benchmarks(const RaycastCase& c);
 // The GPU BVH's: raycast/gpu/<closest|any>/<coherent|incoherent>/<scene> (CUDA builds),
 // in the default layout; with `layouts`, one row set per layout, named .../<scene>/<layout>
-// (gpu::GpuBvhLayout, bvh_layout.h; Auto: the default rows), all in one process.
+// (bvh::GpuBvhLayout, bvh_layout.h; Auto: the default rows), all in one process.
 void register_gpu_raycast_benchmarks(const RaycastCase& c);
-void register_gpu_raycast_benchmarks(const RaycastCase& c, const std::vector<gpu::GpuBvhLayout>& layouts);
+void register_gpu_raycast_benchmarks(const RaycastCase& c, const std::vector<bvh::GpuBvhLayout>& layouts);
 
 }  // namespace pb::bench

@@ -13,7 +13,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "raycast_bench.h"

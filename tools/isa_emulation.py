@@ -4,7 +4,7 @@ at AVX2, and each cap is read back rather than assumed.
 
 - pathbench's batched path step: `pathbench render --isa avx2` (the report's `isa`).
 - Embree 3, in pathbench and pathbench-bench (Debian's libembree3) and in Mitsuba (the
-  libembree3 its wheel bundles): the LD_PRELOAD shim tools/isa_cap/embree_isa_cap.c
+  libembree3 its wheel bundles): the LD_PRELOAD shim scripts/isa_cap/embree_isa_cap.c
   appends `max_isa=avx2` to rtcNewDevice's config. Read back: the native packet widths
   Embree answers (16 only with AVX-512): pathbench's report and pathbench-bench's context
   (fingerprint.embree), and the shim's own record of Mitsuba's device.
@@ -30,8 +30,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-SHIM_SOURCE = ROOT / "tools" / "isa_cap" / "embree_isa_cap.c"
-SHIM_BUILD = ROOT / "tools" / "isa_cap" / "build.sh"
+SHIM_SOURCE = ROOT / "scripts" / "isa_cap" / "embree_isa_cap.c"
+SHIM_BUILD = ROOT / "scripts" / "isa_cap" / "build.sh"
 SHIM_DEFAULT = ROOT / "build" / "isa_cap" / "libembree_isa_cap.so"
 SHIM_ENV = "PATHBENCH_EMBREE_MAX_ISA"
 REEXEC_ENV = "PATHBENCH_ISA_EMULATION_REEXEC"  # set on the re-executed tool: no second re-exec
@@ -62,7 +62,7 @@ def glibc_tunables(isa: str, existing: str | None) -> str:
 
 
 def build_shim(out: Path) -> Path:
-    """Builds the shim (tools/isa_cap/build.sh) unless `out` is newer than its source."""
+    """Builds the shim (scripts/isa_cap/build.sh) unless `out` is newer than its source."""
     out = Path(out).resolve()
     if not out.is_file() or out.stat().st_mtime < SHIM_SOURCE.stat().st_mtime:
         subprocess.run(["bash", str(SHIM_BUILD), str(out)], check=True, stdout=subprocess.DEVNULL)
@@ -207,7 +207,7 @@ def record(isa: str, shim: Path, drjit: dict, mitsuba_embree: dict | None, pathb
         "statement": STATEMENT.format(isa=isa, ISA=isa.upper()),
         "covered": {
             "pathbench_path_step": {"flag": f"--isa {isa}", "isa_ran": pathbench_isa},
-            "embree": {"how": f"LD_PRELOAD {shim.name} (tools/isa_cap/embree_isa_cap.c): max_isa={isa} appended "
+            "embree": {"how": f"LD_PRELOAD {shim.name} (scripts/isa_cap/embree_isa_cap.c): max_isa={isa} appended "
                               "to rtcNewDevice's config", "shim": str(shim),
                        "pathbench": pathbench_embree, "pathbench_bench": bench_embree, "mitsuba": mitsuba_embree},
             "drjit_llvm": drjit,
@@ -242,7 +242,7 @@ def markdown_lines(em: dict) -> list[str]:
         f"**Emulated {em['isa'].upper()}-only host.** {em['statement']} Capped, each read back:",
         f"pathbench's path step `{c['pathbench_path_step']['flag']}` (ran: "
         + ", ".join(f"{s}: {i}" for s, i in c["pathbench_path_step"]["isa_ran"].items()) + ");",
-        f"Embree through the LD_PRELOAD shim tools/isa_cap/embree_isa_cap.c (`max_isa={em['isa']}` appended to "
+        f"Embree through the LD_PRELOAD shim scripts/isa_cap/embree_isa_cap.c (`max_isa={em['isa']}` appended to "
         f"rtcNewDevice's config; native packet widths as Embree answers them, 16 only with AVX-512): pathbench "
         f"{pb_e}; pathbench-bench (raw rates) {widths(e['pathbench_bench'])}; Mitsuba's bundled Embree "
         f"{widths(e['mitsuba'])} (config `{(e['mitsuba'] or {}).get('config', '?')}`);",

@@ -30,7 +30,7 @@ host has) and the ISA each pathbench run used.
 
 `--emulate-isa avx2` stands in for an AVX2-only host on an AVX-512 one (tools/isa_emulation.py):
 every pathbench run gets `--isa avx2`, Embree (pathbench's, pathbench-bench's and the one
-Mitsuba bundles) is capped by the LD_PRELOAD shim tools/isa_cap/embree_isa_cap.c, Dr.Jit's
+Mitsuba bundles) is capped by the LD_PRELOAD shim scripts/isa_cap/embree_isa_cap.c, Dr.Jit's
 LLVM backend is set to haswell with 8 lanes, and glibc's dispatch is capped by its tunables.
 The tool builds the shim (build/isa_cap/, or --embree-shim) and re-executes itself with it
 preloaded. Each cap is read back and recorded (the results' `emulation`); a cap that did not
@@ -316,7 +316,7 @@ def main(argv=None):
                          "Embree through the LD_PRELOAD shim, Dr.Jit's LLVM target, glibc's dispatch) to stand in "
                          "for a host that has only it; results go to mitsuba-vs-pathbench-<isa>cap.*")
     ap.add_argument("--embree-shim", default=str(isa_emulation.SHIM_DEFAULT),
-                    help="the shim for --emulate-isa (built there from tools/isa_cap/ when missing or older)")
+                    help="the shim for --emulate-isa (built there from scripts/isa_cap/ when missing or older)")
     a = ap.parse_args(argv)
     specs = [s for s in a.strategies.split(",")]
     if a.isa:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Per-kernel speed-of-light figures of the GPU tracer from scripts/gpu_roofline.sh's ncu
+"""Per-kernel speed-of-light figures of the GPU tracer from scripts/device/gpu_roofline.sh's ncu
 CSV files: for every kernel, launches, time, achieved instruction issue rate (% of the
 SMs' issue slots while active), SM and memory throughput (% of peak: DRAM, L2, L1),
 DRAM bandwidth in GB/s, occupancy, SIMT efficiency (active threads per instruction / 32)

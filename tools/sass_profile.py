@@ -2,7 +2,7 @@
 """Where a kernel's instructions go, from Nsight Compute's SASS source page.
 
 Reads the CSV that `ncu -i REPORT --page source --csv --print-source sass` writes
-(scripts/gpu_sass_profile.sh makes it; plain or gzipped) and prints, per unit of work (--per:
+(scripts/device/gpu_sass_profile.sh makes it; plain or gzipped) and prints, per unit of work (--per:
 e.g. the launch's samples divided by 32, for warp instructions per warp of samples):
   - the executed warp instructions and the sampled warp stalls by opcode,
   - the hottest straight-line blocks (runs of instructions with one execution count),

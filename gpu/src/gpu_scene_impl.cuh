@@ -8,8 +8,8 @@
 
 #include "cuda_util.h"
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/traversal.h"
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/traversal.h"
 #include "pathbench/gpu/render.h"
 
 namespace pb::gpu {

@@ -4,4 +4,4 @@
 // path loop, which the host can run too), so the pixel megakernel and the wavefront
 // stages trace the same rays and give the same film.
 #include "pathbench/common/path.h"
-#include "pathbench/gpu/path_trace.h"
+#include "pathbench/bvh/path_trace.h"

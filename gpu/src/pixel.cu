@@ -11,7 +11,7 @@
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
-#include "pathbench/gpu/traversal.h"
+#include "pathbench/bvh/traversal.h"
 #include "pathbench/common/errors.h"
 #include "strategies.cuh"
 #include "work_chunks.cuh"

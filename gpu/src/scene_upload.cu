@@ -5,7 +5,7 @@
 
 #include "device_facts.h"
 #include "gpu_scene_impl.cuh"
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 
 namespace pb::gpu {
 

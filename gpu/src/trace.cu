@@ -10,7 +10,7 @@
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/gpu/traversal.h"
+#include "pathbench/bvh/traversal.h"
 #include "pathbench/gpu/render.h"
 
 namespace pb::gpu {

@@ -10,7 +10,7 @@
 #include "device_film.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
-#include "pathbench/gpu/traversal.h"
+#include "pathbench/bvh/traversal.h"
 #include "wavefront_state.cuh"
 #include "work_chunks.cuh"
 

@@ -10,7 +10,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/bvh/traversal.h"
 
 namespace pb::python {
 

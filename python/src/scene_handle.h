@@ -8,7 +8,7 @@
 
 #include "pathbench/common/scene.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/gpu/bvh_build.h"
+#include "pathbench/bvh/bvh_build.h"
 
 namespace pb::python {
 

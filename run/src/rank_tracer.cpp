@@ -6,7 +6,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/cpu/render.h"
-#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/bvh/host_tracer.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/render.h"
 #endif

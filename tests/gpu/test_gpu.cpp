@@ -9,11 +9,11 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/host_tracer.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "film_agreement.h"
@@ -348,24 +348,24 @@ TEST(GpuTraversal, DeviceMatchesHostAndEmbree) {
     const SceneBvhHost bvh = build_scene_bvh(scene, options);
     const Vec3f ext = scene.bounds_max - scene.bounds_min;
     const Vec3f lo = scene.bounds_min + ext * 0.02f, hi = scene.bounds_max - ext * 0.02f;
-    auto rays = test::random_rays(lo, hi, 20000, 9);
-    const auto edge = test::edge_and_vertex_rays(scene, lo, hi, 8, 13);
+    auto rays = bvh::test::random_rays(lo, hi, 20000, 9);
+    const auto edge = bvh::test::edge_and_vertex_rays(scene, lo, hi, 8, 13);
     rays.insert(rays.end(), edge.begin(), edge.end());
     std::vector<TraceQuery> q(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) q[i] = {rays[i].o, rays[i].d, rays[i].t_max};
     const auto dev = trace_on_device(scene, q, false, options);
-    const test::EmbreeReference ref(scene);
-    test::Agreement with_host, with_embree;
+    const bvh::test::EmbreeReference ref(scene);
+    bvh::test::Agreement with_host, with_embree;
     with_embree.edge_rays = true;  // random rays plus rays aimed at edges (see test_traversal.cpp)
     size_t misses = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
-      test::Hit h;
+      bvh::test::Hit h;
       h.prim = traverse<false>(bvh.view(), rays[i].o, rays[i].d, rays[i].t_max, h.t);
-      const test::Hit d{dev[i].prim, dev[i].t};
+      const bvh::test::Hit d{dev[i].prim, dev[i].t};
       with_host.add(rays[i], d, h);  // same code on both sides: no tolerance for edges needed
       misses += d.prim == kNoHit;
-      const test::Hit e = ref.closest(rays[i]);
-      if (e.prim != kNoHit) with_embree.add(rays[i], d, e, test::hit_cos(scene, rays[i], d));
+      const bvh::test::Hit e = ref.closest(rays[i]);
+      if (e.prim != kNoHit) with_embree.add(rays[i], d, e, bvh::test::hit_cos(scene, rays[i], d));
     }
     std::printf("[ INFO     ] %s %s device traversal: %zu rays; vs host: %zu hit/miss, %zu prim (%zu not ties), %zu t; "
                 "vs Embree: %zu hit/miss, %zu prim (%zu not ties), %zu t; %zu misses\n",

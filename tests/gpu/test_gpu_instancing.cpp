@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/host_tracer.h"
 #include "pathbench/gpu/render.h"
 
 namespace pb::gpu {

@@ -11,13 +11,13 @@
 #include <string>
 
 #include "film_agreement.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_facts.h"
-#include "pathbench/gpu/host_tracer.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 namespace {
 
 RenderSettings settings(uint32_t size, uint32_t spp) {
@@ -89,7 +89,7 @@ TEST(HostGpuTracer, RendersWhatTheCpuTracerRenders) {
 // origin were skipped alike on both devices (watertight.h, ray_t_min) it was 99.986 %
 // (results/nvidia-h100-80gb-hbm3/archive/cpu-gpu-t-min-e4b4b93). The CPU's answers are Embree's,
 // whose kernels round by ISA: 65,531 of 65,536 pixels with its AVX2 and AVX-512 kernels
-// (AMD EPYC, Xeon), 65,529 (99.989 %) with its SSE kernels (capped by tools/isa_cap), so
+// (AMD EPYC, Xeon), 65,529 (99.989 %) with its SSE kernels (capped by scripts/isa_cap), so
 // below AVX2 the bound is 99.98 %. ~40 s on 2 cores: unit_slow.
 TEST(HostGpuTracerSlow, PaperFrameWithinAcceptance) {
   const Scene scene = load_scene("paper-cornell");
@@ -108,4 +108,4 @@ TEST(HostGpuTracerSlow, PaperFrameWithinAcceptance) {
 }
 
 }  // namespace
-}  // namespace pb::gpu
+}  // namespace pb::bvh

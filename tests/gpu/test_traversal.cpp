@@ -11,13 +11,13 @@
 #include <random>
 #include <string>
 
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/bvh_layout.h"
 #include "traversal_check.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 namespace {
 
 using test::Agreement;
@@ -436,4 +436,4 @@ TEST(WideBvh, QuantisedBoxesHoldTheirTriangles) {
 }
 
 }  // namespace
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/host_tracer.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 namespace {
 
 const std::string kRoot = std::string(PATHBENCH_SOURCE_DIR) + "/";
@@ -159,4 +159,4 @@ TEST(TwoLevel, FollowsARebasedScene) {
 }
 
 }  // namespace
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/cpu/embree_scene.h"
-#include "pathbench/gpu/bvh.h"
 
-namespace pb::gpu::test {
+namespace pb::bvh::test {
 
 struct Ray3 {
   Vec3f o, d;
@@ -196,4 +196,4 @@ inline float hit_cos(const Scene& s, const Ray3& r, const Hit& h) {
   return std::fabs(dot(n, normalize(r.d)));
 }
 
-}  // namespace pb::gpu::test
+}  // namespace pb::bvh::test

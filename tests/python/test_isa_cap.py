@@ -1,4 +1,4 @@
-"""The Embree ISA-cap shim (tools/isa_cap/embree_isa_cap.c) that tools/mitsuba_speed.py
+"""The Embree ISA-cap shim (scripts/isa_cap/embree_isa_cap.c) that tools/mitsuba_speed.py
 --emulate-isa avx2 preloads: it builds, caps an Embree device at AVX2 (as Embree itself
 answers: no native 16-wide packets), also when Embree is reached through a library loaded
 with RTLD_LOCAL (as Python loads Mitsuba's), and refuses an ISA name Embree would silently
@@ -82,7 +82,7 @@ def _compile(tmp_path, name, source, *flags):
 def shim(tmp_path_factory):
     _cc()
     out = tmp_path_factory.mktemp("shim") / "libembree_isa_cap.so"
-    subprocess.run(["bash", str(ROOT / "tools" / "isa_cap" / "build.sh"), str(out)], check=True,
+    subprocess.run(["bash", str(ROOT / "scripts" / "isa_cap" / "build.sh"), str(out)], check=True,
                    capture_output=True)
     return out
 

@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "embree_rays.h"
+#include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/common/scene_library.h"
-#include "pathbench/gpu/bvh_layout.h"
 
 namespace pb::cpu {
 namespace {
@@ -57,18 +57,18 @@ const CornerRay kCornerBounceRays[] = {
 // clear, the bounce rays' closest hits Embree's, never the plane they start in.
 TEST(EmbreeRays, TheGpuTraversalAgrees) {
   const Scene scene = load_scene("paper-cornell");
-  const gpu::SceneBvhHost bvh = gpu::build_scene_bvh(scene, gpu::GpuBvhOptions{});
-  for (const CornerRay& r : kCornerShadowRays) EXPECT_FALSE(gpu::occluded(bvh.view(), r.o, r.d, 1.0f));
+  const bvh::SceneBvhHost bvh = bvh::build_scene_bvh(scene, bvh::GpuBvhOptions{});
+  for (const CornerRay& r : kCornerShadowRays) EXPECT_FALSE(bvh::occluded(bvh.view(), r.o, r.d, 1.0f));
   const auto embree = make_embree_scene(scene, /*watertight=*/true, EmbreeLayout::Triangles);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   for (const CornerRay& r : kCornerBounceRays) {
     float t = 0;
-    const uint32_t gpu_prim = gpu::intersect_closest(bvh.view(), r.o, r.d, INFINITY, t);
+    const uint32_t gpu_prim = bvh::intersect_closest(bvh.view(), r.o, r.d, INFINITY, t);
     const uint32_t cpu_prim = closest_triangle(*embree, ctx, Ray<float>{r.o, r.d});
-    EXPECT_EQ(gpu_prim == gpu::kNoHit ? RTC_INVALID_GEOMETRY_ID : gpu_prim, cpu_prim)
+    EXPECT_EQ(gpu_prim == bvh::kNoHit ? RTC_INVALID_GEOMETRY_ID : gpu_prim, cpu_prim)
         << "origin " << r.o.x << " " << r.o.y << " " << r.o.z;
-    if (gpu_prim != gpu::kNoHit) EXPECT_GT(t, 0.01f) << "a hit at the ray's own origin";
+    if (gpu_prim != bvh::kNoHit) EXPECT_GT(t, 0.01f) << "a hit at the ray's own origin";
   }
 }
 

@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "pathbench/bvh/bvh_layout.h"
+#include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/isa.h"
-#include "pathbench/gpu/bvh_layout.h"
-#include "pathbench/gpu/host_tracer.h"
 #include "pathbench/run/run.h"
 
 namespace pb {
@@ -134,8 +134,8 @@ RunReport expect_films_equal_flat(const Scene& s) {
   a.begin(rs.spp, s.max_emission());
   b.begin(rs.spp, s.max_emission());
   RunReport ra, rb;
-  gpu::HostGpuTracer(s, Instancing::Off).render(rs, a, ra);
-  gpu::HostGpuTracer(s, Instancing::On).render(rs, b, rb);
+  bvh::HostGpuTracer(s, Instancing::Off).render(rs, a, ra);
+  bvh::HostGpuTracer(s, Instancing::On).render(rs, b, rb);
   EXPECT_EQ(a.raw_sums(), b.raw_sums());
   EXPECT_EQ(rb.extra["instancing"]["used"], true);
   return inst.report;
@@ -150,9 +150,9 @@ TEST(Instancing, CopiesThatLostTrianglesStayFlat) {
   const auto embree = cpu::make_embree_scene(s, true, EmbreeLayout::Triangles, Instancing::On);
   EXPECT_EQ(embree->instancing().instances, 2u);
   EXPECT_EQ(embree->instancing().instances_left_flat, 1u);
-  gpu::GpuBvhOptions o;
+  bvh::GpuBvhOptions o;
   o.instancing = Instancing::On;
-  const gpu::SceneBvhHost two = gpu::build_scene_bvh(s, o);
+  const bvh::SceneBvhHost two = bvh::build_scene_bvh(s, o);
   EXPECT_EQ(two.two_level.instanced, 2u);
   EXPECT_EQ(two.two_level.instances_left_flat, 1u);
   expect_films_equal_flat(s);

@@ -21,7 +21,7 @@
 #include "stability_device.h"
 #include "stat_test.h"
 #ifdef PB_STABILITY_ON_GPU
-#include "pathbench/gpu/bvh.h"
+#include "pathbench/bvh/hit_tests.h"
 #endif
 
 namespace pb {
@@ -152,7 +152,7 @@ std::vector<float> closest_hit_distances(const Scene& scene, const std::vector<s
   std::vector<gpu::TraceQuery> queries;
   for (const auto& [o, d] : rays) queries.push_back({o, d, kMiss});
   for (const gpu::TraceResult& h : gpu::trace_on_device(scene, queries, /*any_hit=*/false))
-    t.push_back(h.prim == gpu::kNoHit ? kMiss : h.t);
+    t.push_back(h.prim == bvh::kNoHit ? kMiss : h.t);
 #else
   const auto embree_scene = cpu::make_embree_scene(scene, /*watertight=*/true, layout);
   const cpu::EmbreeScene& embree = *embree_scene;

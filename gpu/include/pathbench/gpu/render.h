@@ -17,6 +17,10 @@
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
 
+namespace pb::bvh {
+struct GpuBvhOptions;
+}  // namespace pb::bvh
+
 namespace pb::gpu {
 
 // True when a CUDA device can be used; otherwise false and *why_not says why.
@@ -41,7 +45,7 @@ int select_device(int local_rank);
 // Visible CUDA devices (0 where none).
 int device_count();
 
-struct GpuBvhOptions;  // bvh_layout.h
+using bvh::GpuBvhOptions;  // pathbench/bvh/bvh_layout.h
 
 // The scene on the device: arrays and BVH, uploaded once, reusable for many renders.
 // The BVH's layout comes from `options` (binary, wide4, wide8, brute force; bvh_layout.h),

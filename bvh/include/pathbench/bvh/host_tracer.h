@@ -5,17 +5,17 @@
 // bit; the price is speed (this traversal is plain C++, far slower than Embree's). For a
 // CPU working beside GPUs on one frame (the hybrid CPU+GPU render, run/'s RankTracer):
 // then the frame's image is one GPU's whichever device took which samples. In every
-// build, with or without CUDA (pathbench::gpu_bvh).
+// build, with or without CUDA (pathbench::bvh).
 #include <cstdint>
 #include <string>
 
+#include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
-#include "pathbench/gpu/bvh_layout.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 class HostGpuTracer {
  public:
@@ -36,4 +36,4 @@ class HostGpuTracer {
   SceneBvhHost bvh_;
 };
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

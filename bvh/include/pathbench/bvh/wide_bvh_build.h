@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/wide_bvh.h"
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/wide_bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 struct WideBvhHost {
   std::vector<WideNode> nodes;
@@ -27,4 +27,4 @@ struct WideBvhHost {
 // (build it with max_leaf_size = kWideMaxLeafTris to avoid that).
 WideBvhHost collapse_bvh(const BvhHost& binary, uint32_t width);
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -1,6 +1,6 @@
 #pragma once
 // Which acceleration structure the GPU traces against, and its host-side build:
-//   binary  the binary BVH (bvh.h), 64-byte nodes;
+//   binary  the binary BVH (binary_bvh.h), 64-byte nodes;
 //   wide4 / wide8  the compressed wide BVH (wide_bvh.h), 80-byte nodes of <= 4 / 8 children;
 //   brute   no BVH: every triangle tested (brute_force.h), for tiny scenes;
 //   leaves  the binary BVH's leaves, each with its box, and no inner nodes
@@ -18,14 +18,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/traversal.h"
+#include "pathbench/bvh/two_level_build.h"
+#include "pathbench/bvh/wide_bvh_build.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/traversal.h"
-#include "pathbench/gpu/two_level_build.h"
-#include "pathbench/gpu/wide_bvh_build.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6 };
 
@@ -74,7 +74,7 @@ struct SceneBvhHost {
   TwoLevelHost two_level;          // TwoLevel
   uint32_t binary_depth = 0, binary_leaves = 0;  // the binary BVH the wide one came from
   double binary_sah = 0, build_seconds = 0;
-  // The scene has instances: every traversal of it keeps the least (t, id) (bvh.h), so that
+  // The scene has instances: every traversal of it keeps the least (t, id) (hit_tests.h), so that
   // its flat and two-level answers agree; set by build_scene_bvh, carried by view().
   bool exact_ties = false;
 
@@ -91,4 +91,4 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options);
 // structure's bytes and build time (report.extra["instancing"], GPU and HostGpuTracer).
 nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, Instancing asked);
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -1,25 +1,25 @@
 #!/usr/bin/env bash
 # The GPU call of record, on the GPU host (one device call, under 10 minutes on an H100):
-# build, tests and sanitizers of this tree (gpu/run_on_device.sh), the committed bench JSON
+# build, tests and sanitizers of this tree (scripts/device/run_on_device.sh), the committed bench JSON
 # (bench-paper-gpu.json, bench-raycast-gpu.json), paper-cornell-ico:8 and 2048x2048x1024
-# renders, an interleaved A/B (scripts/gpu_ab.sh) against a base made by reversing
-# BASE_PATCH on a copy of this tree, and the roofline (scripts/gpu_roofline.sh) if time is
+# renders, an interleaved A/B (scripts/device/gpu_ab.sh) against a base made by reversing
+# BASE_PATCH on a copy of this tree, and the roofline (scripts/device/gpu_roofline.sh) if time is
 # left. Everything goes to OUT_DIR; console output says what passed.
-#   scripts/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]
-# BASE_PATCH: `git diff BASE -- gpu/ common/` made on the development host; CASES_FILE: the
-# A/B's cases (scripts/gpu_ab.sh's format), else its defaults. Needs .gpu-deps (see
+#   scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]
+# BASE_PATCH: `git diff BASE -- gpu/ bvh/ common/` made on the development host; CASES_FILE: the
+# A/B's cases (scripts/device/gpu_ab.sh's format), else its defaults. Needs .gpu-deps (see
 # ../shared/gpu-host/README.md); PATHBENCH_SOURCE_COMMIT names the commit in the reports
 # (from .gpu-deps/source-commit when set there).
 set -uo pipefail
-out=${1:?usage: scripts/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}
-patch_file=$(realpath "${2:?usage: scripts/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}")
+out=${1:?usage: scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}
+patch_file=$(realpath "${2:?usage: scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}")
 cases=${3:+$(realpath "$3")}
 for f in "$patch_file" ${cases:+"$cases"}; do  # before anything is made
   if [ ! -f "$f" ] || [ ! -r "$f" ]; then echo "gpu_record.sh: $f: not a readable file" >&2; exit 2; fi
 done
 mkdir -p "$out"
 out=$(realpath "$out")
-cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
+cd "$(dirname "${BASH_SOURCE[0]}")/../.." || exit 1
 # shellcheck disable=SC1091  # made on the development host (../shared/gpu-host/README.md)
 if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh > /dev/null; fi
 export PATH=$PATH:/usr/local/cuda/bin
@@ -36,7 +36,7 @@ rm -rf $base && mkdir -p $base && tar --exclude=./build-gpu --exclude=./build --
 (cmake -S $base -B $base/build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF \
    -DCMAKE_CUDA_ARCHITECTURES=90 > /dev/null 2>&1 && cmake --build $base/build-gpu -j 5 --target pathbench \
    > "$out/base-build.log" 2>&1; echo "base build rc=$?") &
-OUT=$out bash gpu/run_on_device.sh build test sanitize > "$out/run_on_device.txt" 2>&1
+OUT=$out bash scripts/device/run_on_device.sh build test sanitize > "$out/run_on_device.txt" 2>&1
 echo "build + test + sanitize rc=$?"
 wait
 grep -E "ctest|passed|ERROR SUMMARY|hazard|PaperFrameWithinAcceptance" "$out/summary.txt" | head -24
@@ -70,11 +70,11 @@ for name in ["bench-paper-gpu.json", "bench-raycast-gpu.json"]:
             extra = f" {b['rays_per_second']/1e9:.2f} Grays/s" if "rays_per_second" in b else ""
             print(f"{b['run_name'][:70]:70s} {b['real_time']:.3f} {b['time_unit']}{extra}")
 PY
-NO_RAYCAST=${NO_RAYCAST:-} CASES=$cases bash scripts/gpu_ab.sh $base/build-gpu build-gpu "$out/ab" 3 > "$out/ab-summary.txt" 2>&1
+NO_RAYCAST=${NO_RAYCAST:-} CASES=$cases bash scripts/device/gpu_ab.sh $base/build-gpu build-gpu "$out/ab" 3 > "$out/ab-summary.txt" 2>&1
 echo "ab rc=$?"; cat "$out/ab-summary.txt"
 rm -rf "$out/ab/films"
 if [ $SECONDS -lt 420 ]; then
-  LAUNCHES=60 bash scripts/gpu_roofline.sh build-gpu "$out/roofline" > "$out/roofline.txt" 2>&1
+  LAUNCHES=60 bash scripts/device/gpu_roofline.sh build-gpu "$out/roofline" > "$out/roofline.txt" 2>&1
   echo "roofline rc=$? at ${SECONDS}s"
 else
   echo "roofline skipped at ${SECONDS}s"

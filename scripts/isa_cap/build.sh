@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the Embree ISA-cap shim (embree_isa_cap.c: why it exists, and its environment).
-#   tools/isa_cap/build.sh [OUT.so]     default: build/isa_cap/libembree_isa_cap.so
+#   scripts/isa_cap/build.sh [OUT.so]     default: build/isa_cap/libembree_isa_cap.so
 # Needs only a C compiler (no Embree headers). Use it as
 #   LD_PRELOAD=OUT.so PATHBENCH_EMBREE_MAX_ISA=avx2 COMMAND ...
 set -euo pipefail

@@ -4,13 +4,13 @@
 # (and the pixel megakernel on paper-cornell-ico:8), the achieved instruction issue rate
 # and memory throughput against the device's peaks. Runs on the GPU host (ncu there reads
 # the counters); tools/roofline.py turns the CSV into JSON, a table and a plot.
-#   scripts/gpu_roofline.sh BUILD_DIR OUT_DIR
+#   scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR
 # --clock-control none: the clocks stay as the benchmarks see them (METHOD.md); each
 # kernel launch is replayed by ncu, so the frames are small (the rates per kernel are
 # what counts, not the frame time) and at most LAUNCHES launches are profiled per run.
 set -uo pipefail
-build=${1:?usage: scripts/gpu_roofline.sh BUILD_DIR OUT_DIR}
-out=${2:?usage: scripts/gpu_roofline.sh BUILD_DIR OUT_DIR}
+build=${1:?usage: scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR}
+out=${2:?usage: scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR}
 launches=${LAUNCHES:-40}
 mkdir -p "$out"
 metrics=gpu__time_duration.sum,sm__cycles_elapsed.avg.per_second,sm__inst_executed.sum,\

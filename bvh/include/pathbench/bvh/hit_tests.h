@@ -1,19 +1,22 @@
 #pragma once
-// The GPU's BVH: a binary BVH built on the host by Embree's BVH builder
-// (gpu/src/bvh_build.cpp), flattened into 64-byte nodes that hold both children's
-// boxes (Aila & Laine 2009), and 48-byte triangles stored in leaf order. The traversal
-// below is host+device code: the GPU kernels and the host-side tests that check it
-// against Embree run the same function.
+// The hit tests every traversal of the BVH library shares (binary_bvh.h, wide_bvh.h,
+// leaf_list.h, brute_force.h, two_level_bvh.h): the triangle record they read (48 bytes,
+// in leaf order) and the references to a leaf's run of them; the triangle test with its
+// tie rule (the least (t, id) wins where a scene has instances); the slab test of a box;
+// the bit helpers of child and leaf masks. Host+device code: the GPU kernels and the
+// host-side tests run the same functions.
 #include <cstdint>
 
+#include "pathbench/bvh/gpu_names.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
 #include "pathbench/common/moller_trumbore.h"
 #include "pathbench/common/watertight.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
-// Child reference: an inner node's index, or a leaf (top bit set) holding up to
+// Child reference (a binary node's child, a leaf list's entry, either level of the
+// two-level BVH): an inner node's index, or a leaf (top bit set) holding up to
 // kMaxLeafPrims consecutive triangles from `first`.
 constexpr uint32_t kLeafBit = 0x80000000u;
 constexpr uint32_t kMaxLeafPrims = 16;
@@ -22,16 +25,6 @@ PB_HD bool is_leaf(uint32_t ref) { return (ref & kLeafBit) != 0; }
 PB_HD uint32_t leaf_first(uint32_t ref) { return ref & kLeafFirstMask; }
 PB_HD uint32_t leaf_count(uint32_t ref) { return ((ref >> 27) & 15u) + 1; }
 PB_HD uint32_t make_leaf_ref(uint32_t first, uint32_t count) { return kLeafBit | ((count - 1) << 27) | first; }
-
-// Two children's boxes, laid out for three 16-byte loads, and their references.
-struct alignas(16) BvhNode {
-  float x[4];  // c0.lo.x, c0.hi.x, c1.lo.x, c1.hi.x
-  float y[4];
-  float z[4];
-  uint32_t child[2];
-  uint32_t pad[2];
-};
-static_assert(sizeof(BvhNode) == 64, "BvhNode is one 64-byte line");
 
 // A triangle's vertices in leaf order; v0's fourth word is the scene's triangle id.
 struct alignas(16) BvhTriangle {
@@ -44,18 +37,7 @@ struct alignas(16) BvhTriangle {
 };
 static_assert(sizeof(BvhTriangle) == 48, "BvhTriangle is 48 bytes");
 
-// What the binary traversal reads: host or device pointers. (The kernels get a BvhView,
-// traversal.h: the scene's BVH in whichever layout it was built.)
-struct BinaryBvhView {
-  const BvhNode* nodes;      // node 0 is the root, always an inner node
-  const BvhTriangle* tris;
-  uint32_t num_nodes;
-  uint32_t num_tris;
-  uint32_t exact_ties = 0;   // detail::test_vertices: the least (t, id) wins (scenes with instances)
-};
-
 constexpr uint32_t kNoHit = 0xFFFFFFFFu;
-constexpr int kTraversalStackSize = 64;  // the builder limits the depth to fit
 
 struct TraversalStats {
   uint32_t nodes = 0, tris = 0;
@@ -65,26 +47,9 @@ namespace detail {
 
 PB_HD float fmadd(float a, float b, float c) {
 #if defined(__CUDA_ARCH__)
-  return __fmaf_rn(a, b, c);  // explicit: the library is built with --fmad=false
+  return __fmaf_rn(a, b, c);  // explicit: gpu/ builds its kernels with --fmad=false
 #else
   return a * b + c;
-#endif
-}
-
-PB_HD void load_node(const BvhNode* nodes, uint32_t i, float (&x)[4], float (&y)[4], float (&z)[4],
-                     uint32_t (&child)[2]) {
-#if defined(__CUDA_ARCH__)
-  const float4* p = reinterpret_cast<const float4*>(nodes + i);
-  const float4 a = __ldg(p), b = __ldg(p + 1), c = __ldg(p + 2);
-  const uint4 d = __ldg(reinterpret_cast<const uint4*>(p + 3));
-  x[0] = a.x; x[1] = a.y; x[2] = a.z; x[3] = a.w;
-  y[0] = b.x; y[1] = b.y; y[2] = b.z; y[3] = b.w;
-  z[0] = c.x; z[1] = c.y; z[2] = c.z; z[3] = c.w;
-  child[0] = d.x; child[1] = d.y;
-#else
-  const BvhNode& n = nodes[i];
-  for (int k = 0; k < 4; ++k) { x[k] = n.x[k]; y[k] = n.y[k]; z[k] = n.z[k]; }
-  child[0] = n.child[0]; child[1] = n.child[1];
 #endif
 }
 
@@ -254,88 +219,4 @@ PB_HD void slab_interval(float x0, float x1, float y0, float y1, float z0, float
 
 }  // namespace detail
 
-namespace detail {
-
-// Walks a binary BVH (node 0 the root) front to back for the ray (o, d), skipping boxes
-// beyond `t`, the best distance so far (read at every node: the leaf test narrows it).
-// leaf(first, count) tests a leaf's items and returns true to end the walk (an any-hit
-// query's hit); then walk_binary returns true. Shared by the flat traversal below and
-// both levels of the two-level one (two_level_bvh.h).
-template <class Leaf>
-PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, const float& t, Leaf&& leaf,
-                       TraversalStats* stats) {
-  const SlabRay sr = make_slab_ray(o, d);
-  uint32_t stack[kTraversalStackSize];
-  int sp = 0;
-  uint32_t ref = 0;
-  for (;;) {
-    while (!is_leaf(ref)) {
-      float x[4], y[4], z[4];
-      uint32_t child[2];
-      load_node(nodes, ref, x, y, z, child);
-      if (stats) ++stats->nodes;
-      float tn[2], tf[2];
-      for (int c = 0; c < 2; ++c)
-        slab_interval(x[2 * c], x[2 * c + 1], y[2 * c], y[2 * c + 1], z[2 * c], z[2 * c + 1], sr, t, tn[c], tf[c]);
-      const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
-      if (h0 && h1) {
-        const bool swap = tn[1] < tn[0];
-        ref = swap ? child[1] : child[0];
-        stack[sp++] = swap ? child[0] : child[1];
-      } else if (h0 || h1) {
-        ref = h0 ? child[0] : child[1];
-      } else {
-        if (sp == 0) return false;
-        ref = stack[--sp];
-      }
-    }
-    if (leaf(leaf_first(ref), leaf_count(ref))) return true;
-    if (sp == 0) return false;
-    ref = stack[--sp];
-  }
-}
-
-}  // namespace detail
-
-// Closest hit (kAnyHit = false) or any hit (true) for ray_t_min < t < t_max (watertight.h:
-// a few float ulps of the origin, so that a hit at the ray's own origin counts on no
-// device) along the ray's own direction (need not be unit length). Returns the scene
-// triangle id, or kNoHit; t_hit receives the distance of a hit. kWatertight = false swaps
-// the triangle test for Moeller-Trumbore (the paper's; the accuracy study's comparison;
-// it keeps 0 < t).
-// kExact: the view's exact_ties read at run time (-1), or known at compile time (0, 1):
-// the hot kernels are compiled for one or the other, since a run-time flag keeps the tie
-// compare's registers live in every kernel (ptxas, sm_90, k_pixel: 48 -> 60 bytes of
-// spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (docs/notes/gpu-log.md).
-template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
-PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
-                        TraversalStats* stats = nullptr) {
-  const bool exact = kExact < 0 ? bvh.exact_ties != 0 : kExact == 1;
-  const WatertightRay wr = make_watertight_ray(o, d);
-  uint32_t hit = kNoHit, hit_slot = 0;
-  float t = t_max;
-  const bool stopped = detail::walk_binary(
-      bvh.nodes, o, d, t,
-      [&](uint32_t first, uint32_t count) {
-        return detail::test_leaf_triangles<kAnyHit, kWatertight>(bvh.tris, first, count, wr, o, d, t_max, exact, t,
-                                                                 hit, hit_slot, stats);
-      },
-      stats);
-  if (kAnyHit && stopped) {
-    t_hit = t;
-    return hit;
-  }
-  return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
-}
-
-template <bool kWatertight = true>
-PB_HD uint32_t intersect_closest(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit) {
-  return traverse<false, kWatertight>(bvh, o, d, t_max, t_hit);
-}
-template <bool kWatertight = true>
-PB_HD bool occluded(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max) {
-  float t;
-  return traverse<true, kWatertight>(bvh, o, d, t_max, t) != kNoHit;
-}
-
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -1,4 +1,4 @@
-#include "pathbench/gpu/bvh_layout.h"
+#include "pathbench/bvh/bvh_layout.h"
 
 #include <fmt/core.h>
 
@@ -10,7 +10,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 namespace {
 constexpr struct {
@@ -184,4 +184,4 @@ nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, In
       .to_json();
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -8,16 +8,16 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "pathbench/bvh/binary_bvh.h"
+#include "pathbench/bvh/brute_force.h"
+#include "pathbench/bvh/leaf_list.h"
+#include "pathbench/bvh/two_level_bvh.h"
+#include "pathbench/bvh/wide_bvh.h"
 #include "pathbench/common/hd.h"
-#include "pathbench/gpu/brute_force.h"
-#include "pathbench/gpu/bvh.h"
-#include "pathbench/gpu/leaf_list.h"
-#include "pathbench/gpu/two_level_bvh.h"
-#include "pathbench/gpu/wide_bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
-// Binary: bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
+// Binary: binary_bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
 // brute_force.h, the triangles in scene order in `tris` and no nodes. TwoLevel:
 // two_level_bvh.h, the instanced scene's (--instancing). Leaves: leaf_list.h, the binary
 // BVH's leaves without its inner nodes (tiny scenes without instances).
@@ -40,7 +40,7 @@ struct BvhView {
 // kKind: a TraversalKind the caller was compiled for (bvh.kind must be it), or
 // kAnyKind to switch on bvh.kind. kBinaryExactTies: the binary BVH of a scene with
 // instances traced flat (exact_ties set), compiled apart from Binary (exact_ties unset)
-// so that flat scenes' kernels carry no tie compare (bvh.h's traverse, kExact).
+// so that flat scenes' kernels carry no tie compare (binary_bvh.h's traverse, kExact).
 constexpr int kAnyKind = -1;
 constexpr int kBinaryExactTies = 5;
 
@@ -97,4 +97,4 @@ decltype(auto) with_traversal_kind(const BvhView& bvh, Fn&& fn) {
   }
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

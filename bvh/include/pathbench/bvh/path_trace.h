@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <limits>
 
+#include "pathbench/bvh/traversal.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/path.h"
-#include "pathbench/gpu/traversal.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -55,4 +55,4 @@ PB_HD Vec3f trace_path_bvh(const SceneView& s, const BvhView& bvh, const PathCon
   return Vec3f(st.L);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

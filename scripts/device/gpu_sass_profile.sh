@@ -3,18 +3,18 @@
 # Compute's source counters (executed instructions, thread-level executed instructions and
 # sampled warp stalls per SASS address) for the pixel megakernel on paper-cornell and the
 # raw incoherent closest-hit ray casts on the same scene. Runs on the GPU host, after
-# gpu/run_on_device.sh's build (BUILD_DIR/bin/pathbench, pathbench-bench);
+# scripts/device/run_on_device.sh's build (BUILD_DIR/bin/pathbench, pathbench-bench);
 # tools/sass_profile.py turns the SASS CSV into tables by opcode and by hot block. (The
 # source page's CUDA view is not exported: with -lineinfo it gave only the kernel's own file,
 # without counts.)
-#   scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR
-# --clock-control none as in scripts/gpu_roofline.sh. One launch per kernel, after the first
+#   scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR
+# --clock-control none as in scripts/device/gpu_roofline.sh. One launch per kernel, after the first
 # (a render's first launch is its warm-up frame, one sample a pixel, whose warps span 32
 # pixels; the bench's is its warm-up): the counts are per launch (pixel: 256x256 x SPP
 # samples; ray casts: the bench's stored rays). SKIP=0 profiles the first launch instead.
 set -uo pipefail
-build=${1:?usage: scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
-out=${2:?usage: scripts/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
+build=${1:?usage: scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
+out=${2:?usage: scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
 spp=${SPP:-16}
 mkdir -p "$out"
 sections=(--section SourceCounters --section WarpStateStats --section InstructionStats --section LaunchStats

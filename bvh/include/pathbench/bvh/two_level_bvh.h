@@ -6,21 +6,22 @@
 // only to walk the bottom BVH's boxes; every triangle is tested in world space, on the
 // flat scene's triangle (SceneView's positions and triangles, which shading reads anyway),
 // with the flat traversal's own test. So the answer is the flat BVH's, bit for bit: the
-// closest hit is the least (t, triangle id) of the same per-triangle tests (bvh.h:
+// closest hit is the least (t, triangle id) of the same per-triangle tests (hit_tests.h:
 // detail::closer), whatever order either structure visits them in, provided no box
 // culls a triangle the world-space test would hit. The bottom boxes are padded for that
 // (two_level_build.cpp: by the measured distance between each instance's flat triangles
 // and its transformed prototype, plus the rounding of the ray's transform).
 // The triangles no instance covers (walls, lights, instances that lost triangles to
-// finalize()) form one more bottom BVH under the identity. Host+device code, as bvh.h.
+// finalize()) form one more bottom BVH under the identity. Host+device code, as binary_bvh.h.
 #include <cstdint>
 
+#include "pathbench/bvh/binary_bvh.h"
+#include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 struct alignas(16) TwoLevelInstance {
   float inv[12];            // row-major 3x4: traced (world) coordinates -> the prototype's
@@ -100,4 +101,4 @@ PB_HD uint32_t traverse_two_level(const TwoLevelView& v, const Vec3f& o, const V
   return hit;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -22,7 +22,7 @@
  * CDLL(None)) returns JSON: devices created through the shim, the last config, and the
  * last device's native packet widths as Embree answers them (16 only with AVX-512).
  *
- * Build: tools/isa_cap/build.sh [OUT.so]  (gcc -shared -fPIC ... -ldl; no Embree headers).
+ * Build: scripts/isa_cap/build.sh [OUT.so]  (gcc -shared -fPIC ... -ldl; no Embree headers).
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>

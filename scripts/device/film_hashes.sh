@@ -2,9 +2,9 @@
 # Hashes of GPU films for a fixed set of renders (each strategy, float and double, both
 # triangle tests, variance on and off), to check that a refactor leaves them
 # bit-identical: run it on the tree before and after, and diff the two outputs.
-# Usage: gpu/film_hashes.sh [build-dir] > hashes.txt   (needs a CUDA build and a GPU)
+# Usage: scripts/device/film_hashes.sh [build-dir] > hashes.txt   (needs a CUDA build and a GPU)
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 pb=${1:-build-gpu}/bin/pathbench
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

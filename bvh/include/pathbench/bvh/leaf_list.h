@@ -8,16 +8,16 @@
 // and then tests the triangles of those: the nearest box first, the others again
 // against the t that found (a closest hit), or in order until one is hit (any hit).
 // Same box test as the binary BVH's last level (detail::slab_interval on the same
-// padded boxes) and the same triangle test, so the same hits (bvh.h's rules on ties).
+// padded boxes) and the same triangle test, so the same hits (hit_tests.h's rules on ties).
 // Host+device, as the other traversals.
 #include <cstdint>
 #include <limits>
 
+#include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
-#include "pathbench/gpu/bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 // One leaf: its box and its triangles (make_leaf_ref(first, count)), two 16-byte loads.
 struct alignas(16) LeafBox {
@@ -66,7 +66,7 @@ PB_HD bool enters_leaf(const LeafBox* leaves, uint32_t i, const SlabRay& sr, flo
 
 }  // namespace detail
 
-// Closest hit (kAnyHit = false) or any hit, as traverse() in bvh.h (kExact likewise).
+// Closest hit (kAnyHit = false) or any hit, as traverse() in binary_bvh.h (kExact likewise).
 template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
 PB_HD uint32_t traverse_leaves(const LeafListView& f, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                              TraversalStats* stats = nullptr) {
@@ -119,4 +119,4 @@ PB_HD uint32_t traverse_leaves(const LeafListView& f, const Vec3f& o, const Vec3
   return detail::finish_closest<kWatertight>(f.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

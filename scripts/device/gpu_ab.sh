@@ -5,15 +5,15 @@
 # of pathbench-bench for both. Prints, per case, the median device ms of A and B, B/A,
 # and whether every film of B hashed as A's (a change meant to keep the images).
 # NO_RAYCAST=1 leaves out the ray-cast rows.
-#   scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]
+#   scripts/device/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]
 # Cases: CASES (a file of "name | [VAR=value ...] pathbench render options" lines: leading
 # VAR=value words are set in the environment of both builds' runs), else the paper's
 # frame on paper-cornell (pixel, wavefront, paper-queue; nee and uniform) and
 # paper-cornell-ico:8 (pixel).
 set -uo pipefail
-a=${1:?usage: scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
-b=${2:?usage: scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
-out=${3:?usage: scripts/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
+a=${1:?usage: scripts/device/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
+b=${2:?usage: scripts/device/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
+out=${3:?usage: scripts/device/gpu_ab.sh BUILD_A BUILD_B OUT_DIR [ROUNDS]}
 rounds=${4:-5}
 mkdir -p "$out/films"
 frame="--width 256 --height 256 --spp 800 --bounces 2"

@@ -5,13 +5,13 @@
 // whole warp) and never diverge in the loop. Host+device, as the BVH traversals.
 #include <cstdint>
 
+#include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
-#include "pathbench/gpu/bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
-// Closest hit (kAnyHit = false) or any hit among tris[0..n), as traverse() in bvh.h:
+// Closest hit (kAnyHit = false) or any hit among tris[0..n), as traverse() in binary_bvh.h:
 // same triangle test, so the same answer (of two triangles at exactly the same t, the
 // lower id: detail::closer).
 template <bool kAnyHit, bool kWatertight = true>
@@ -29,4 +29,4 @@ PB_HD uint32_t traverse_all(const BvhTriangle* tris, uint32_t n, const Vec3f& o,
   return detail::finish_closest<kWatertight>(tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

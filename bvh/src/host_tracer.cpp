@@ -1,4 +1,4 @@
-#include "pathbench/gpu/host_tracer.h"
+#include "pathbench/bvh/host_tracer.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -7,10 +7,10 @@
 #include <atomic>
 #include <chrono>
 
+#include "pathbench/bvh/path_trace.h"
 #include "pathbench/common/features.h"
-#include "pathbench/gpu/path_trace.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 HostGpuTracer::HostGpuTracer(const Scene& scene, Instancing instancing)
     : scene_(scene), bvh_(build_scene_bvh(scene, GpuBvhOptions::from_env(instancing))) {}
@@ -61,4 +61,4 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   report.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -1,4 +1,4 @@
-#include "pathbench/gpu/wide_bvh_build.h"
+#include "pathbench/bvh/wide_bvh_build.h"
 
 #include <fmt/core.h>
 
@@ -8,7 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 namespace {
 
@@ -221,4 +221,4 @@ WideBvhHost collapse_bvh(const BvhHost& binary, uint32_t width) {
   return out;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

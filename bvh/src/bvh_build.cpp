@@ -1,4 +1,4 @@
-#include "pathbench/gpu/bvh_build.h"
+#include "pathbench/bvh/bvh_build.h"
 
 #include <embree3/rtcore.h>
 #include <fmt/core.h>
@@ -9,7 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 namespace {
 
@@ -277,4 +277,4 @@ BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options) {
   return out;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -4,7 +4,7 @@
 // Traversal on GPUs Through Compressed Wide BVHs", HPG 2017). An 80-byte node replaces
 // up to 7 binary 64-byte nodes, so a ray reads about a third of the node bytes and
 // keeps far fewer stack entries. Built on the host by collapsing the binary BVH
-// (gpu/src/wide_bvh_build.cpp); the traversal below is host+device code, so the
+// (bvh/src/wide_bvh_build.cpp); the traversal below is host+device code, so the
 // host-side tests run exactly what the kernels run.
 //
 // Traversal follows the paper: a stack of "node groups" (the base index of a node's inner
@@ -14,9 +14,9 @@
 #include <cstdint>
 #include <cstring>
 
+#include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
-#include "pathbench/gpu/bvh.h"
 
 // The per-node loops must unroll on the device: their small arrays then live in
 // registers, not in local memory.
@@ -26,7 +26,7 @@
 #define PB_WIDE_UNROLL
 #endif
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 constexpr uint32_t kWideMaxChildren = 8;
 constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
@@ -108,7 +108,7 @@ PB_HD float byte_as_float(uint32_t w, int k) {
 
 }  // namespace detail
 
-// Closest hit (kAnyHit = false) or any hit, as traverse() in bvh.h: same triangle test,
+// Closest hit (kAnyHit = false) or any hit, as traverse() in binary_bvh.h: same triangle test,
 // same answer (the triangle with the smallest t; of two at exactly the same t, the lower
 // id: detail::closer).
 template <bool kAnyHit, bool kWatertight = true>
@@ -206,4 +206,4 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

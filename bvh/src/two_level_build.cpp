@@ -2,13 +2,13 @@
 // prototype's triangles in its own coordinates, the rest of the scene's triangles as
 // they are, and the instances' world boxes (each as a stand-in triangle spanning its
 // box's two corners, whose box is exactly that box).
-#include "pathbench/gpu/two_level_build.h"
+#include "pathbench/bvh/two_level_build.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 namespace {
 
@@ -164,4 +164,4 @@ TwoLevelHost build_two_level_bvh(const Scene& s, const BvhBuildOptions& options)
   return out;
 }
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -7,7 +7,7 @@
 #   (pathbench-bench --preset gpu-layouts), and the GPU tests in each layout.
 #   source .gpu-deps/unpack.sh is done here; see ../shared/gpu-host/README.md.
 set -uo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 OUT=${OUT:-$PWD/device-out}
 mkdir -p "$OUT/logs" "$OUT/json"
 pack() {

@@ -5,11 +5,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "pathbench/bvh/bvh_build.h"
+#include "pathbench/bvh/two_level_bvh.h"
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh_build.h"
-#include "pathbench/gpu/two_level_bvh.h"
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 struct TwoLevelHost {
   std::vector<BvhNode> top_nodes;
@@ -39,4 +39,4 @@ struct TwoLevelHost {
 
 TwoLevelHost build_two_level_bvh(const Scene& scene, const BvhBuildOptions& options = {});
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh

@@ -4,9 +4,9 @@
 # they match. The GPU's must match everywhere (two_level_bvh.h); the CPU's match but for
 # rare rays meeting a copy's edge (docs/notes/cpu-log.md). Prints "device strategy scene off on same|DIFF"
 # and exits 1 if a GPU line differs.
-# Usage: gpu/instancing_hashes.sh [build-dir] [WxHxSPP]   (needs a CUDA build and a GPU)
+# Usage: scripts/device/instancing_hashes.sh [build-dir] [WxHxSPP]   (needs a CUDA build and a GPU)
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 pb=${1:-build-gpu}/bin/pathbench
 IFS=x read -r w h spp <<< "${2:-256x192x16}"
 tmp=$(mktemp -d)

@@ -5,11 +5,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "pathbench/bvh/binary_bvh.h"
+#include "pathbench/bvh/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
 #include "pathbench/common/scene.h"
-#include "pathbench/gpu/bvh.h"
-#include "pathbench/gpu/traversal.h"  // BvhView: what view() converts to for the dispatching traversal
 
-namespace pb::gpu {
+namespace pb::bvh {
 
 struct BvhBuildOptions {
   unsigned max_leaf_size = 4;     // <= kMaxLeafPrims
@@ -35,4 +35,4 @@ struct BvhHost {
 
 BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options = {});
 
-}  // namespace pb::gpu
+}  // namespace pb::bvh
