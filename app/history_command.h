@@ -6,6 +6,7 @@
 namespace pb::app {
 
 // argv: the arguments after `history`. Returns only when the hand-over failed (exit status 2).
-int run_history(int argc, char** argv);
+// `module`: the tools/ package run (`pathbench suite` hands over to tools/suite the same way).
+int run_history(int argc, char** argv, const char* module = "history");
 
 }  // namespace pb::app

@@ -1,0 +1,197 @@
+"""`pathbench suite` (tools/suite): manifest validation, the quick suite end to end (strict
+JSON, records in a database outside the tree, the page in headless Chromium), energy records
+where NVML/RAPL are absent, RAPL counter wrap."""
+import json
+import re
+import os
+import shutil
+import sqlite3
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from suite import manifest, results
+
+ROOT = Path(__file__).resolve().parents[2]
+PATHBENCH = ROOT / "build" / "bin" / "pathbench"
+BENCH = ROOT / "build" / "bin" / "pathbench-bench"
+TEST_MANIFEST = ROOT / "tests" / "suite" / "manifest.json"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+needs_build = pytest.mark.skipif(not (PATHBENCH.exists() and BENCH.exists()),
+                                 reason="needs build/bin/pathbench and pathbench-bench (scripts/build.sh)")
+
+
+def strict_load(path):
+    def refuse(c):
+        raise ValueError(f"{path}: {c}")
+    return json.loads(Path(path).read_text(), parse_constant=refuse)
+
+
+def suite(*args, env=None, cwd=None):
+    e = dict(os.environ)
+    e.update(env or {})
+    return subprocess.run([str(PATHBENCH), "suite", *map(str, args)], capture_output=True, text=True, env=e,
+                          cwd=cwd, timeout=900)
+
+
+def write_manifest(tmp_path, workloads, **top):
+    doc = {"suite": "pathbench", "version": 1, "workloads": workloads} | top
+    p = tmp_path / "manifest.json"
+    p.write_text(json.dumps(doc))
+    return p
+
+
+def good_workload(**kw):
+    w = {"name": "box", "scene": "paper-cornell", "stresses": "s", "triangles": 14, "instanced_triangles": 0,
+         "materials": ["diffuse"], "licence": "l", "settings": {"width": 8, "height": 8, "spp": 1},
+         "quick": {"width": 8, "height": 8, "spp": 1}}
+    w.update(kw)
+    return w
+
+
+@pytest.mark.parametrize("bad, field", [
+    ({"settings": {"width": 8, "height": 8}}, "settings: 'spp' is missing"),
+    ({"settings": {"width": 8, "height": 8, "spp": 1, "sampling": "magic"}}, "settings.sampling"),
+    ({"settings": {"width": 8, "height": 8, "spp": 1, "lens": 3}}, "settings.lens: unknown setting"),
+    ({"triangles": -1}, "triangles"),
+    ({"name": "a b"}, "name"),
+    ({"scene": "nowhere.json"}, "scene: nowhere.json: no such file"),
+    ({"requires": [{"package": "p"}]}, "requires[0]"),
+    ({"color": "red"}, "color: unknown field"),
+])
+def test_manifest_errors_name_the_file_and_field(tmp_path, bad, field):
+    p = write_manifest(tmp_path, [good_workload(**bad)])
+    with pytest.raises(manifest.ManifestError) as e:
+        manifest.load(str(p))
+    assert str(p) in str(e.value) and field in str(e.value)
+
+
+def test_manifest_top_level_and_regex_errors(tmp_path):
+    for text, what in [("{", "not valid JSON"), ('{"suite": "x", "version": 1, "workloads": []}', "suite"),
+                       ('{"suite": "pathbench", "version": 0, "workloads": []}', "version"),
+                       ('{"suite": "pathbench", "version": 1, "workloads": [1e999]}', "workloads[0]")]:
+        p = tmp_path / "m.json"
+        p.write_text(text)
+        with pytest.raises(manifest.ManifestError, match=re.escape(what)):
+            manifest.load(str(p))
+    m = manifest.load(str(write_manifest(tmp_path, [good_workload(), good_workload(name="two")])))
+    assert [w["name"] for w in manifest.select(m, "^t")] == ["two"]
+    for pattern, what in [("(", "not a regular expression"), ("zzz", "matches no workload")]:
+        with pytest.raises(manifest.ManifestError, match=what):
+            manifest.select(m, pattern)
+    dup = write_manifest(tmp_path, [good_workload(), good_workload()])
+    with pytest.raises(manifest.ManifestError, match="appears twice"):
+        manifest.load(str(dup))
+
+
+def test_missing_or_empty_mesh_names_package_and_file(tmp_path):
+    w = good_workload(requires=[{"package": "libcgal-demo", "file": "bunny00.off"}])
+    m = manifest.load(str(write_manifest(tmp_path, [w])))
+    why = manifest.missing_requirement(m["workloads"][0], str(tmp_path / "data"))
+    assert "libcgal-demo" in why and "bunny00.off" in why
+    (tmp_path / "data" / "meshes").mkdir(parents=True)
+    (tmp_path / "data" / "meshes" / "bunny00.off").write_text("")
+    assert "empty" in manifest.missing_requirement(m["workloads"][0], str(tmp_path / "data"))
+    (tmp_path / "data" / "meshes" / "bunny00.off").write_text("OFF\n")
+    assert manifest.missing_requirement(m["workloads"][0], str(tmp_path / "data")) is None
+
+
+def test_u_test_verdicts_follow_compare():
+    a = [10.0 + 0.01 * i for i in range(9)]
+    assert results.verdict(a, a)["verdict"] == "same"
+    assert results.verdict([x * 1.2 for x in a], a)["verdict"] == "slower"
+    assert results.verdict([x * 0.8 for x in a], a)["verdict"] == "faster"
+    assert results.verdict([x * 1.02 for x in a], a)["verdict"] == "same"  # under the 5 % threshold
+    assert results.mann_whitney_p(a, [x + 100 for x in a]) < 1e-3
+
+
+@needs_build
+def test_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path):
+    out = tmp_path / "page"
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"suite": "pathbench", "version": 1, "workloads": [{"name": "x"}]}')
+    for args, what in [(["--manifest", bad], "bad.json: workloads[0] (x).scene: missing"),
+                       (["--manifest", TEST_MANIFEST, "--workloads", "("], "--workloads: not a regular expression"),
+                       (["--manifest", TEST_MANIFEST, "--workloads", "nothing-matches"], "matches no workload"),
+                       (["--manifest", TEST_MANIFEST, "--devices", "tpu"], "--devices: unknown device 'tpu'"),
+                       (["--manifest", TEST_MANIFEST, "--bogus"], "unrecognized arguments")]:
+        r = suite(*args, "--out", out, "--db", tmp_path / "h.sqlite")
+        assert r.returncode == 2, (args, r.stderr)
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and what in lines[0], r.stderr
+    assert not out.exists() and not (tmp_path / "h.sqlite").exists()
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+@needs_build
+def test_quick_suite_end_to_end(tmp_path):
+    """The CI subset: built-in workloads at quick size on the CPU, 9 repetitions; twice, so the
+    second page compares with the first run from the database."""
+    data_home = tmp_path / "xdg"
+    env = {"XDG_DATA_HOME": str(data_home), "PATHBENCH_DATA_DIR": str(tmp_path / "data")}
+    out1, out2 = tmp_path / "run1", tmp_path / "run2"
+    r = suite("--quick", "--manifest", TEST_MANIFEST, "--devices", "cpu", "--workloads", "paper-uniform|needs-mesh",
+              "--out", out1, env=env)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert "skipped needs-mesh" in r.stderr and "pathbench-test-no-such-package" in r.stderr
+    db = data_home / "pathbench" / "history.sqlite"
+    assert db.exists() and ROOT not in db.parents  # the default database, outside the tree
+    r2 = suite("--quick", "--manifest", TEST_MANIFEST, "--devices", "cpu", "--workloads", "paper-uniform",
+               "--out", out2, env=env)
+    assert r2.returncode == 0, r2.stderr[-3000:]
+    s = strict_load(out2 / "suite.json")
+    bench = [strict_load(out2 / f) for f in s["bench_json"]]
+    assert s["version"] == 1 and s["mode"] == "quick" and s["preset"] == "suite-quick"
+    row = next(r for r in s["rows"] if r["workload"] == "paper-uniform")
+    assert row["status"] == "ok" and row["repetitions"] == 9 and row["ms"] > 0 and row["rays_per_second"] > 0
+    assert row["film_hash"].startswith("fnv1a64:") and row["peak_host_bytes"] > 0
+    assert row["previous"]["verdict"] in ("same", "faster", "slower")  # against run 1, from the database
+    # Energy: a number where RAPL is readable, else null with the reason (this VM: no powercap).
+    if row["joules_per_frame"] is None:
+        assert row["energy_reason"] and "powercap" in row["energy_reason"]
+        assert "energy_unavailable" in bench[0]["context"]
+    con = sqlite3.connect(db)
+    presets = con.execute("SELECT preset, count(*) FROM runs GROUP BY preset").fetchall()
+    n = con.execute("SELECT count(*) FROM results WHERE benchmark = 'suite/paper-uniform/cpu/pixel'").fetchone()[0]
+    con.close()
+    assert presets == [("suite-quick", 2)] and n == 18
+    s1 = strict_load(out1 / "suite.json")
+    skipped = next(r for r in s1["rows"] if r["workload"] == "needs-mesh")
+    assert skipped["status"] == "skipped" and "no-such-mesh.off" in skipped["reason"]
+    md = (out2 / "suite.md").read_text()
+    assert "paper-uniform" in md and "vs previous run" in md
+    html = (out2 / "index.html").read_text()
+    assert "paper-uniform" in html and "<script" not in html
+    if CHROMIUM:
+        r = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--enable-logging=stderr",
+                            "--v=0", f"--user-data-dir={tmp_path / 'profile'}", "--dump-dom",
+                            (out2 / "index.html").as_uri()], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr[-2000:]
+        assert [l for l in r.stderr.splitlines() if ":CONSOLE" in l] == []
+        assert "paper-uniform" in r.stdout and "vs previous run" in r.stdout
+
+
+@needs_build
+def test_render_report_energy_null_with_reason_and_rapl_wrap(tmp_path):
+    """No powercap here: energy null with the reason. A fake powercap tree whose counter
+    wraps: the joules are the wrapped difference, never negative."""
+    out = tmp_path / "r.json"
+    base = [str(PATHBENCH), "render", "--scene", "paper-cornell", "--width", "16", "--height", "16", "--spp", "2",
+            "--report", str(out)]
+    env = dict(os.environ, PATHBENCH_POWERCAP_ROOT=str(tmp_path / "none"))
+    r = subprocess.run(base, capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    e = strict_load(out)["energy"]
+    assert e["joules"] is None and "does not exist" in e["reason"] and e["source"] == "rapl"
+    # A counter that reads near its maximum and is not advancing: 0 J, not "max_range" J.
+    fake = tmp_path / "powercap" / "intel-rapl:0"
+    fake.mkdir(parents=True)
+    (fake / "energy_uj").write_text("999990\n")
+    (fake / "max_energy_range_uj").write_text("1000000\n")
+    (fake / "name").write_text("package-0\n")
+    env["PATHBENCH_POWERCAP_ROOT"] = str(tmp_path / "powercap")
+    r = subprocess.run(base, capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    e = strict_load(out)["energy"]
+    assert e["joules"] == 0 and e["rays_per_joule"] is None
