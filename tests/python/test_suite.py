@@ -7,6 +7,8 @@ import os
 import shutil
 import sqlite3
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -153,7 +155,7 @@ def test_quick_suite_end_to_end(tmp_path):
         assert "energy_unavailable" in bench[0]["context"]
     con = sqlite3.connect(db)
     presets = con.execute("SELECT preset, count(*) FROM runs GROUP BY preset").fetchall()
-    n = con.execute("SELECT count(*) FROM results WHERE benchmark = 'suite/paper-uniform/cpu/pixel'").fetchone()[0]
+    n = con.execute("SELECT count(*) FROM results WHERE benchmark = 'suite/paper-uniform/cpu/pixel/manual_time'").fetchone()[0]
     con.close()
     assert presets == [("suite-quick", 2)] and n == 18
     s1 = strict_load(out1 / "suite.json")
@@ -190,8 +192,43 @@ def test_render_report_energy_null_with_reason_and_rapl_wrap(tmp_path):
     (fake / "energy_uj").write_text("999990\n")
     (fake / "max_energy_range_uj").write_text("1000000\n")
     (fake / "name").write_text("package-0\n")
+    (tmp_path / "powercap" / "intel-rapl:0:0").mkdir()  # a sub-zone (core, dram): not counted
     env["PATHBENCH_POWERCAP_ROOT"] = str(tmp_path / "powercap")
     r = subprocess.run(base, capture_output=True, text=True, env=env)
     assert r.returncode == 0, r.stderr
     e = strict_load(out)["energy"]
     assert e["joules"] == 0 and e["rays_per_joule"] is None
+    # The counter wraps during the render: a FIFO hands out 999990 (the probe), 999990 (start)
+    # and then 10 (end): 20 uJ, not a negative or a 1 J figure.
+    (fake / "energy_uj").unlink()
+    os.mkfifo(fake / "energy_uj")
+
+    def feed():  # one value per open; the pause lets the reader close before the next one
+        for v in ("999990", "999990", "10"):
+            with open(fake / "energy_uj", "w") as f:
+                f.write(v + "\n")
+            time.sleep(0.3)
+    t = threading.Thread(target=feed, daemon=True)
+    t.start()
+    r = subprocess.run(base, capture_output=True, text=True, env=env, timeout=60)
+    t.join(10)
+    assert r.returncode == 0, r.stderr
+    e = strict_load(out)["energy"]
+    assert e["joules"] == pytest.approx(20e-6) and e["source"] == "rapl"
+    assert e["rays_per_joule"] == pytest.approx(strict_load(out)["rays"]["total"] / 20e-6)
+
+
+@needs_build
+def test_compare_flags_a_throttled_run(tmp_path):
+    def bench(path, ms, throttled):
+        rows = [{"name": "render/gpu/pixel/x/manual_time", "run_name": "render/gpu/pixel/x/manual_time",
+                 "run_type": "iteration", "repetition_index": i, "iterations": 10, "real_time": ms + 0.01 * i,
+                 "cpu_time": ms, "time_unit": "ms", "throttled": float(throttled), "throttle_reasons": 4.0 * throttled}
+                for i in range(9)]
+        path.write_text(json.dumps({"context": {"date": "2026-11-26"}, "benchmarks": rows}))
+        return path
+    a, b = bench(tmp_path / "a.json", 10.0, 0), bench(tmp_path / "b.json", 10.0, 1)
+    r = subprocess.run([str(PATHBENCH), "compare", str(a), str(b)], capture_output=True, text=True)
+    assert "THROTTLED in new" in r.stdout, r.stdout + r.stderr
+    r = subprocess.run([str(PATHBENCH), "compare", str(a), str(a)], capture_output=True, text=True)
+    assert "THROTTLED" not in r.stdout

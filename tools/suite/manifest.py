@@ -72,7 +72,7 @@ def _workload(path: str, i: int, w) -> dict:
     for k in w:
         if k not in WORKLOAD_KEYS | OPTIONAL_KEYS:
             raise ManifestError(f"{path}: {where}.{k}: unknown field")
-    for k in WORKLOAD_KEYS - OPTIONAL_KEYS:
+    for k in ("scene", "stresses", "triangles", "materials", "licence", "settings"):
         if k not in w:
             raise ManifestError(f"{path}: {where}.{k}: missing")
     for k in ("scene", "stresses", "licence"):
