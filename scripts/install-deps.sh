@@ -50,4 +50,6 @@ if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
     echo "[install-deps] .venv: up to date"
   fi
 fi
+# The suite's meshes (Debian libcgal-demo) into the data folder: scripts/install-suite-data.sh.
+"$root/scripts/install-suite-data.sh"
 echo "[install-deps] done"

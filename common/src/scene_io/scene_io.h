@@ -44,6 +44,7 @@ Scene parse_scene_json(const std::string& path, const std::string& text, const F
 Scene parse_scene_obj(const std::string& path, const std::string& text, const FileReader& read,
                       const Losses& losses = Losses());
 Scene parse_scene_ply(const std::string& path, const std::string& text, const Losses& losses = Losses());
+Scene parse_scene_off(const std::string& path, const std::string& text, const Losses& losses = Losses());
 // .gltf (JSON; its buffers read through `read`) or .glb (binary), by `binary`.
 Scene parse_scene_gltf(const std::string& path, const std::string& text, bool binary, const FileReader& read,
                        const Losses& losses = Losses());
@@ -59,10 +60,15 @@ struct MeshData {
   std::vector<std::string> material_names;
 };
 MeshData read_ply(const std::string& path, const std::string& text, const Losses& losses);
+MeshData read_off(const std::string& path, const std::string& text, const Losses& losses);
+// Loop subdivision (Loop 1987), `levels` times: every triangle becomes four, new edge
+// points and moved old ones by Loop's weights (boundary and non-manifold edges as
+// creases: the boundary rules). Material ids follow the parent triangle.
+MeshData loop_subdivide(const MeshData& mesh, int levels);
 // An OBJ; with_materials: its MTL libraries through `read`, else none.
 MeshData read_obj_mesh(const std::string& path, const std::string& text, bool with_materials, const FileReader& read,
                        const Losses& losses);
-// A mesh file named by a scene (JSON "file", Mitsuba "filename"): .obj or .ply, read
+// A mesh file named by a scene (JSON "file", Mitsuba "filename"): .obj, .ply or .off, read
 // through `read`; `budget` is what the scene's mesh files have used so far (one limit
 // for all of them).
 MeshData read_mesh_file(const std::string& path, bool with_materials, const FileReader& read, const Losses& losses,
