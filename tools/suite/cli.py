@@ -158,7 +158,8 @@ def run(a) -> int:
     if a.list:
         for w in chosen:
             s = manifest.run_settings(w, a.quick)
-            print(f"{w['name']:<24} {s['width']}x{s['height']} {s['spp']} spp  {w['triangles']:>11,} tri  {w['stresses']}")
+            tri = manifest.triangle_estimate(w, manifest.data_dir(), a.quick)
+            print(f"{w['name']:<20} {s['width']}x{s['height']} {s['spp']:>4} spp {tri:>11,} tri  {w['stresses'][:70]}")
         return 0
     run_devs, skipped_devs = devices.plan(exe, a.devices)
     rank, size = devices.mpi_world()
@@ -292,3 +293,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("pathbench suite: interrupted; nothing written", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # `pathbench suite --list | head`
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except OSError as e:
+        print(f"pathbench suite: failed: {e}", file=sys.stderr)
+        return 3
