@@ -197,13 +197,12 @@ def run(a) -> int:
 def _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_rows, mode, preset, db, stamp, rank, size, t0):
     groups = [[d] for d in run_devs]
     if size > 1:  # under mpirun: one pathbench-bench for every device, its frames over the ranks
-        groups = [run_devs]
+        groups = [[dict(d, label=f"ranks{size}-{d['label']}") for d in run_devs]]
     plans = []
     for g in groups:
         cases, label = [], "-".join(d["label"] for d in g)
         for d in g:
-            cases += runner.cases_for(runnable, d, a.quick, a.isa, manifest.data_dir(),
-                                      f"ranks{size}-" if size > 1 else "")
+            cases += runner.cases_for(runnable, d, a.quick, a.isa, manifest.data_dir())
         plans.append((g, label, cases))
     total = sum(len(c) for _, _, c in plans) * a.repetitions
     progress = runner.Progress(total)

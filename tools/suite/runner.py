@@ -22,8 +22,7 @@ def case_name(workload: dict, label: str, settings: dict) -> str:
     return f"suite/{workload['name']}/{label}/{strategy_of(settings)}"
 
 
-def cases_for(workloads: list[dict], device: dict, quick: bool, isa: str | None, data: str,
-              label_prefix: str = "") -> list[dict]:
+def cases_for(workloads: list[dict], device: dict, quick: bool, isa: str | None, data: str) -> list[dict]:
     cases = []
     for w in workloads:
         s = dict(manifest.run_settings(w, quick))
@@ -31,7 +30,7 @@ def cases_for(workloads: list[dict], device: dict, quick: bool, isa: str | None,
             s["isa"] = isa
         if device["device"] == "gpu":
             s.pop("isa", None)
-        c = {"workload": w["name"], "name": case_name(w, label_prefix + device["label"], s),
+        c = {"workload": w["name"], "name": case_name(w, device["label"], s),
              "scene": manifest.scene_of(w, quick), "device": device["device"], "settings": s}
         if manifest.triangle_estimate(w, data, quick) >= BIG_SCENE:
             c["iterations"] = 1 if device["device"] == "cpu" else 3
