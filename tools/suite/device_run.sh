@@ -12,7 +12,8 @@
 set -uo pipefail
 out=${1:?usage: device_run.sh OUT [BUDGET] [MACHINE]}
 budget=${2:-560}
-machine=${3:-gpu-host}
+machine=${3:-}  # default: the history names it by its CPU (intel-r-xeon-r...)
+name=(); [ -n "$machine" ] && name=("${name[@]}")
 start=$(date +%s)
 left() { echo $((budget - ($(date +%s) - start))); }
 mkdir -p "$out"
@@ -33,7 +34,7 @@ PB=/tmp/build-gpu/bin/pathbench
 db=/tmp/pathbench-ref.sqlite
 runs=$out/runs
 $PB --version | tee -a "$log"
-timeout $(($(left) - 20)) $PB suite --devices gpu --machine "$machine" --db $db --export "$runs" \
+timeout $(($(left) - 20)) $PB suite --devices gpu "${name[@]}" --db $db --export "$runs" \
   --out "$out/suite-gpu" 2>&1 | tr '\r' '\n' | grep -v '^\[#*\.*\] ' >> "$log"
 echo "== $(date -u +%T) suite gpu rc=${PIPESTATUS[0]} ($(left)s left)" | tee -a "$log"
 for dev in gpu cpu; do
@@ -41,13 +42,13 @@ for dev in gpu cpu; do
   timeout $(($(left) - 30)) $PB bench --preset paper --repetitions 9 --benchmark_filter="render/$dev/" \
     --benchmark_min_time=1 --out "$out/bench-paper-$dev.json" > "$out/bench-paper-$dev.txt" 2>&1
   echo "== $(date -u +%T) paper bench $dev rc=$? ($(left)s left)" | tee -a "$log"
-  [ -f "$out/bench-paper-$dev.json" ] && $PB history record --db $db --export "$runs" --machine "$machine" \
+  [ -f "$out/bench-paper-$dev.json" ] && $PB history record --db $db --export "$runs" "${name[@]}" \
     "$out/bench-paper-$dev.json" >> "$log" 2>&1
 done
 mode=()
 [ "$(left)" -gt 300 ] || mode=(--quick)
 if [ "$(left)" -gt 60 ]; then
-  timeout $(($(left) - 10)) $PB suite --devices cpu "${mode[@]}" --machine "$machine" --db $db --export "$runs" \
+  timeout $(($(left) - 10)) $PB suite --devices cpu "${mode[@]}" "${name[@]}" --db $db --export "$runs" \
     --out "$out/suite-cpu" 2>&1 | tr '\r' '\n' | grep -v '^\[#*\.*\] ' >> "$log"
   echo "== $(date -u +%T) suite cpu ${mode[*]} rc=${PIPESTATUS[0]} ($(left)s left)" | tee -a "$log"
 fi
