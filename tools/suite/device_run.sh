@@ -13,7 +13,7 @@ set -uo pipefail
 out=${1:?usage: device_run.sh OUT [BUDGET] [MACHINE]}
 budget=${2:-560}
 machine=${3:-}  # default: the history names it by its CPU (intel-r-xeon-r...)
-name=(); [ -n "$machine" ] && name=("${name[@]}")
+name=(); [ -n "$machine" ] && name=(--machine "$machine")
 start=$(date +%s)
 left() { echo $((budget - ($(date +%s) - start))); }
 mkdir -p "$out"
