@@ -62,6 +62,8 @@ def parse_args(argv):
     ap.add_argument("--out", help="folder for the page and the JSON (default: "
                     "$XDG_DATA_HOME/pathbench/suite/<date>-<mode>)")
     ap.add_argument("--list", action="store_true", help="list the workloads and exit")
+    ap.add_argument("--from-json", nargs="+", metavar="BENCH.json", help="no measurement: the page and the records "
+                    "from the suite's bench JSON written earlier (a run cut short, another host); --quick if it was one")
     a = ap.parse_args(argv)
     if a.repetitions < 1:
         raise InputError("--repetitions: must be at least 1 (9 for compare's U test)")
@@ -158,9 +160,24 @@ def run(a) -> int:
     if a.list:
         for w in chosen:
             s = manifest.run_settings(w, a.quick)
-            tri = manifest.triangle_estimate(w, manifest.data_dir(), a.quick)
-            print(f"{w['name']:<20} {s['width']}x{s['height']} {s['spp']:>4} spp {tri:>11,} tri  {w['stresses'][:70]}")
+            flat, inst = manifest.triangle_estimate(w, manifest.data_dir(), a.quick)
+            print(f"{w['name']:<20} {s['width']}x{s['height']} {s['spp']:>4} spp {flat:>11,} tri {inst:>12,} instanced  "
+                  f"{w['stresses'][:60]}")
         return 0
+    if a.from_json:
+        db = None if a.no_record else (a.db or default_db())
+        if db:
+            _check_db(db)
+        stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+        out = a.out or os.path.join(_data_home(), "pathbench", "suite", f"{stamp}-{mode}")
+        _check_out(out)
+        parent = os.path.dirname(os.path.abspath(out)) or "."
+        os.makedirs(parent, exist_ok=True)
+        work = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.partial-", dir=parent)
+        try:
+            return _from_json(a, work, out, m, chosen, mode, preset, db, time.monotonic())
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
     run_devs, skipped_devs = devices.plan(exe, a.devices)
     rank, size = devices.mpi_world()
     db = None if a.no_record else (a.db or default_db())
@@ -238,6 +255,39 @@ def _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_row
     progress.close()
     if rank != 0:
         return 0
+    return _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t0)
+
+
+def _from_json(a, work, out, m, chosen, mode, preset, db, t0) -> int:
+    """--from-json: the page and the records from bench JSON an earlier run wrote (a run cut
+    short, or one made on another host): no measurement."""
+    rows, files, ctx = [], [], {}
+    names = {w["name"]: w for w in chosen}
+    for path in a.from_json:
+        try:
+            doc = _finite(runner.read_bench_json(path, strict=False))
+        except (OSError, ValueError) as e:
+            raise InputError(f"--from-json {path}: not readable bench JSON ({e})") from None
+        if not isinstance(doc, dict) or not isinstance(doc.get("benchmarks"), list):
+            raise InputError(f"--from-json {path}: not Google Benchmark JSON")
+        ctx = ctx or doc.get("context", {})
+        seen = {}
+        for b in doc["benchmarks"]:
+            parts = str(b.get("run_name", b.get("name", ""))).split("/")
+            if len(parts) >= 4 and parts[0] == "suite" and parts[1] in names:
+                seen.setdefault((parts[1], parts[2], parts[3]), None)
+        for (wl, label, strategy) in seen:
+            dev = {"label": label, "device": "gpu" if "gpu" in label else "cpu",
+                   "name": doc.get("context", {}).get("gpu_name", "") if "gpu" in label else "CPU"}
+            case = runner.cases_for([names[wl]], dev, mode == "quick", None, manifest.data_dir())[0]
+            rows += results.rows_from_bench(doc, [case], dev)
+        dest = os.path.join(work, os.path.basename(path))
+        shutil.copyfile(path, dest)
+        files.append(dest)
+    return _report(a, work, out, m, chosen, rows, files, ctx, mode, preset, db, t0)
+
+
+def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t0) -> int:
     order = {w["name"]: i for i, w in enumerate(chosen)}
     rows.sort(key=lambda r: (order.get(r["workload"], 0), r["device"]))
     if db:

@@ -213,26 +213,30 @@ def _off_faces(f: str) -> int:
         return 0
 
 
-def triangle_estimate(workload: dict, data: str, quick: bool) -> int:
-    """The flat triangles a frame's BVH holds: the manifest's count, else (0 there) the JSON scene's
-    meshes from the data folder (OFF headers, x4 per Loop subdivision level) plus its triangles."""
-    if workload["triangles"] > 0:
-        return workload["triangles"]
+def triangle_estimate(workload: dict, data: str, quick: bool) -> tuple[int, int]:
+    """(flat, instanced) triangles of a frame: the manifest's counts, else (0 there) the JSON
+    scene's meshes from the data folder (OFF headers, x4 per Loop subdivision level, x the
+    number of "instances") plus its triangles."""
+    flat, inst = workload["triangles"], workload["instanced_triangles"]
+    if flat > 0 or inst > 0:
+        return flat, inst
     scene = workload["quick_scene"] if quick else workload["scene"]
     if not scene.endswith(".json") or not os.path.isfile(scene) or os.path.getsize(scene) > 64 << 20:
-        return 0
+        return 0, 0
     try:
         with open(scene) as fh:
             doc = json.load(fh)
-        n = 0
         for m in doc.get("meshes", []) if isinstance(doc, dict) else []:
             f = m.get("file", "") if isinstance(m, dict) else ""
             if isinstance(f, str) and f.startswith("data:"):
-                faces = _off_faces(os.path.join(data, f[len("data:"):]))
-                n += faces * 4 ** int(m.get("subdivide", 0) or 0)
-        return n
+                faces = _off_faces(os.path.join(data, f[len("data:"):])) * 4 ** int(m.get("subdivide", 0) or 0)
+                if isinstance(m.get("instances"), list):
+                    inst += faces * len(m["instances"])
+                else:
+                    flat += faces
+        return flat, inst
     except (OSError, ValueError, TypeError, AttributeError):
-        return 0
+        return 0, 0
 
 
 def scene_of(workload: dict, quick: bool) -> str:

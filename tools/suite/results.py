@@ -7,6 +7,7 @@ import glob
 import json
 import math
 import os
+import re
 import sqlite3
 import statistics
 
@@ -35,7 +36,8 @@ def rows_from_bench(doc: dict, cases: list[dict], device: dict) -> list[dict]:
     full: dict[str, str] = {}  # case name -> the JSON's (and the history's) name: ".../manual_time"
     for b in doc.get("benchmarks", []):
         name = b.get("run_name", b.get("name", ""))
-        short = name[: -len("/manual_time")] if name.endswith("/manual_time") else name
+        # Google Benchmark appends /iterations:N (a fixed count: large scenes) and /manual_time.
+        short = re.sub(r"(/iterations:\d+)?(/manual_time)?$", "", name)
         full[short] = name
         name = short
         if b.get("error_occurred"):
