@@ -46,7 +46,7 @@ void add_energy_counters(benchmark::State& state, const std::string& name, nlohm
     state.counters["sm_clock_mhz_min"] = e["sm_clock_mhz"]["min"].get<double>();
   }
   if (e.contains("temperature_c")) state.counters["temperature_c_max"] = e["temperature_c"]["max"].get<double>();
-  if (e.contains("throttle_reasons")) {
+  if (e.contains("throttle_reasons") && e["throttled"].is_boolean()) {
     state.counters["throttle_reasons"] = double(e["throttle_reasons"].get<uint64_t>());
     state.counters["throttled"] = e["throttled"].get<bool>() ? 1.0 : 0.0;
   }

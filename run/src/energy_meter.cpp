@@ -168,6 +168,7 @@ struct EnergyMeter::Impl {
   bool stop_flag = false;
   uint64_t reasons = 0;
   unsigned samples = 0, clock_min = ~0u, clock_max = 0, temp_max = 0, power_max_mw = 0;
+  unsigned reason_reads = 0, temp_reads = 0, power_reads = 0, clock_reads = 0;  // successful reads: no figure without one
   double clock_sum = 0;
 
   void sample() {
@@ -180,10 +181,20 @@ struct EnergyMeter::Impl {
       clock_min = std::min(clock_min, v);
       clock_max = std::max(clock_max, v);
       clock_sum += v;
+      ++clock_reads;
     }
-    if (n.temperature && n.temperature(n.device, 0 /* NVML_TEMPERATURE_GPU */, &v) == 0) temp_max = std::max(temp_max, v);
-    if (n.power && n.power(n.device, &v) == 0) power_max_mw = std::max(power_max_mw, v);
-    if (n.reasons && n.reasons(n.device, &r) == 0) reasons |= r;
+    if (n.temperature && n.temperature(n.device, 0 /* NVML_TEMPERATURE_GPU */, &v) == 0) {
+      temp_max = std::max(temp_max, v);
+      ++temp_reads;
+    }
+    if (n.power && n.power(n.device, &v) == 0) {
+      power_max_mw = std::max(power_max_mw, v);
+      ++power_reads;
+    }
+    if (n.reasons && n.reasons(n.device, &r) == 0) {
+      reasons |= r;
+      ++reason_reads;
+    }
   }
 };
 
@@ -260,13 +271,17 @@ nlohmann::json EnergyMeter::stop() {
     if (s.why_not.empty()) joules = double(end_mj - s.start_mj) * 1e-3;
     if (s.samples > 0) {
       r["samples"] = s.samples;
-      if (s.clock_max > 0)
-        r["sm_clock_mhz"] = {{"min", s.clock_min}, {"mean", s.clock_sum / s.samples}, {"max", s.clock_max}};
-      r["temperature_c"] = {{"max", s.temp_max}};
-      r["power_watts"] = {{"max", s.power_max_mw * 1e-3}};
-      r["throttle_reasons"] = s.reasons;
-      r["throttle"] = throttle_reason_names(s.reasons);
-      r["throttled"] = (s.reasons & kThrottleMask) != 0;
+      if (s.clock_reads)
+        r["sm_clock_mhz"] = {{"min", s.clock_min}, {"mean", s.clock_sum / s.clock_reads}, {"max", s.clock_max}};
+      if (s.temp_reads) r["temperature_c"] = {{"max", s.temp_max}};
+      if (s.power_reads) r["power_watts"] = {{"max", s.power_max_mw * 1e-3}};
+      if (s.reason_reads) {
+        r["throttle_reasons"] = s.reasons;
+        r["throttle"] = throttle_reason_names(s.reasons);
+        r["throttled"] = (s.reasons & kThrottleMask) != 0;
+      } else {
+        r["throttled"] = nullptr;  // NVML gave no clock-event reasons: unknown, not "not throttled"
+      }
     }
   }
   if (joules >= 0) {

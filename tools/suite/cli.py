@@ -126,7 +126,9 @@ def _facts(s: dict, ctx: dict, elapsed: float, reps: int) -> list:
          ("CPU", f"{ctx.get('cpu_model', '?')} ({ctx.get('cpu_hardware_threads', '?')} threads)")]
     gpus = sorted({r["device_name"] for r in s["rows"] if r["device"].startswith("gpu") and r.get("device_name")})
     f.append(("GPU", ", ".join(gpus) if gpus else "none"))
-    f += [("repetitions", reps), ("manifest", s["manifest_sha256"][:12]), ("took", f"{elapsed / 60:.1f} min")]
+    f += [("repetitions", reps), ("manifest", s["manifest_sha256"][:12])]
+    if elapsed is not None:
+        f.append(("took", f"{elapsed / 60:.1f} min"))
     return f
 
 
@@ -175,7 +177,7 @@ def run(a) -> int:
         os.makedirs(parent, exist_ok=True)
         work = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.partial-", dir=parent)
         try:
-            return _from_json(a, work, out, m, chosen, mode, preset, db, time.monotonic())
+            return _from_json(a, work, out, m, chosen, mode, preset, db, None)
         finally:
             shutil.rmtree(work, ignore_errors=True)
     run_devs, skipped_devs = devices.plan(exe, a.devices)
@@ -284,6 +286,11 @@ def _from_json(a, work, out, m, chosen, mode, preset, db, t0) -> int:
         dest = os.path.join(work, os.path.basename(path))
         shutil.copyfile(path, dest)
         files.append(dest)
+    have = {r["workload"] for r in rows}
+    for w in chosen:
+        if w["name"] not in have:
+            rows.append({"workload": w["name"], "device": "-", "status": "skipped",
+                         "reason": "not measured: no result for it in the bench JSON given"})
     return _report(a, work, out, m, chosen, rows, files, ctx, mode, preset, db, t0)
 
 
@@ -299,7 +306,8 @@ def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t
             if p and r["status"] == "ok":
                 r["previous"] = results.verdict(r["times_ms"], p["times_ms"]) | {"run_date": p["run_date"],
                                                                                  "commit": p["commit"]}
-    refs = results.reference_runs(a.references, preset) if a.references and os.path.isdir(a.references) else {}
+    sources = {os.path.basename(f) for f in bench_files}
+    refs = results.reference_runs(a.references, preset, sources) if a.references and os.path.isdir(a.references) else {}
     ref_names = sorted(n for n, per in refs.items() if any(r.get("benchmark") in per for r in rows))
     for r in rows:
         for n in ref_names:
@@ -308,6 +316,9 @@ def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t
                 r.setdefault("references", {})[n] = {"ms": results._median(ref["times_ms"]), "run_date": ref["run_date"],
                                                      "commit": ref["commit"]}
     name = a.machine or ctx.get("machine", "this machine")
+    gpus = sorted({r.get("device_name") for r in rows if r["device"].startswith("gpu") and r.get("device_name")})
+    if gpus and not a.machine:
+        name = f"{', '.join(gpus)} ({name} host)"
     summary = {"suite": "pathbench", "version": m["version"], "mode": mode, "preset": preset,
                "date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                "machine": {"name": name, "machine_id": ctx.get("machine_id"), "cpu": ctx.get("cpu_model"),
@@ -317,8 +328,12 @@ def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t
                "repetitions": a.repetitions, "db": db, "reference_machines": ref_names,
                "command": "pathbench suite " + " ".join(sys.argv[1:]),
                "bench_json": [os.path.basename(f) for f in bench_files], "rows": rows,
-               "workloads": [dict(w, run_settings=manifest.run_settings(w, a.quick)) for w in chosen]}
-    summary["facts"] = _facts(summary, ctx, time.monotonic() - t0, a.repetitions)
+               "workloads": [dict(w, run_settings=manifest.run_settings(w, a.quick),
+                                  triangles=max(w["triangles"], manifest.triangle_estimate(w, manifest.data_dir(), a.quick)[0]),
+                                  instanced_triangles=max(w["instanced_triangles"],
+                                                          manifest.triangle_estimate(w, manifest.data_dir(), a.quick)[1]))
+                             for w in chosen]}
+    summary["facts"] = _facts(summary, ctx, None if t0 is None else time.monotonic() - t0, a.repetitions)
     summary = _finite(summary)
     with open(os.path.join(work, "suite.json"), "w") as f:
         json.dump(summary, f, indent=1, allow_nan=False)

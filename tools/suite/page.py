@@ -46,6 +46,8 @@ def _cells(r: dict, ref_names: list[str]) -> list[tuple[str, str, str]]:
                                               if r.get("energy_busy_fraction") is not None else "")
     if r.get("joules_per_frame") is None:
         energy = "n/a"
+    elif (r.get("energy_busy_fraction") or 1) < 0.5:  # the window was mostly BVH builds between frames
+        energy += f" ({r['energy_busy_fraction'] * 100:.0f}% frame)"
     if r.get("throttled") is None:
         clocks = ("–", "", "")
     else:

@@ -158,7 +158,7 @@ def previous_runs(db_path: str, sources: list[str], preset: str) -> dict[str, di
     return latest
 
 
-def reference_runs(export_dir: str, preset: str) -> dict[str, dict]:
+def reference_runs(export_dir: str, preset: str, exclude_sources=()) -> dict[str, dict]:
     """machine name -> {benchmark: {times_ms, run_date, commit}} from the text export: each
     reference machine's latest run of the preset, per benchmark."""
     refs: dict[str, dict] = {}
@@ -166,8 +166,8 @@ def reference_runs(export_dir: str, preset: str) -> dict[str, dict]:
         try:
             with open(path) as f:
                 head = json.loads(f.readline())["run"]
-                if head.get("preset") != preset:
-                    continue
+                if head.get("preset") != preset or head.get("source") in exclude_sources:
+                    continue  # another preset, or this very run (recorded into the export just now)
                 name = head.get("machine_name") or head.get("machine_id", "?")
                 date = head.get("run_date", "")
                 per = refs.setdefault(name, {})
