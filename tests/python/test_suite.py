@@ -256,3 +256,38 @@ def test_the_suites_manifest_loads_and_a_quick_subset_runs(tmp_path):
         assert "libcgal-demo" in by["bunny-armadillo"]["reason"]
     else:
         assert by["bunny-armadillo"]["triangles"] > 100_000
+
+
+def test_a_truncated_mesh_is_named_by_its_checksum(tmp_path):
+    data = tmp_path / "data"
+    (data / "meshes").mkdir(parents=True)
+    good = b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+    import hashlib
+    w = good_workload(requires=[{"package": "libcgal-demo", "file": "tri.off", "sha256": hashlib.sha256(good).hexdigest()}])
+    m = manifest.load(str(write_manifest(tmp_path, [w])))
+    (data / "meshes" / "tri.off").write_bytes(good[:-8])  # cut short
+    why = manifest.missing_requirement(m["workloads"][0], str(data))
+    assert "tri.off" in why and "libcgal-demo" in why and "SHA-256" in why
+    (data / "meshes" / "tri.off").write_bytes(good)
+    assert manifest.missing_requirement(m["workloads"][0], str(data)) is None
+
+
+@needs_build
+def test_a_malformed_scene_skips_its_workload_and_the_rest_run(tmp_path):
+    (tmp_path / "broken.json").write_text('{"camera": ')
+    p = write_manifest(tmp_path, [good_workload(), good_workload(name="broken", scene="broken.json")])
+    r = suite("--quick", "--manifest", p, "--devices", "cpu", "--repetitions", "2", "--no-record",
+              "--out", tmp_path / "out")
+    assert r.returncode == 0, r.stderr[-2000:]
+    rows = {row["workload"]: row for row in strict_load(tmp_path / "out" / "suite.json")["rows"]}
+    assert rows["box"]["status"] == "ok"
+    assert rows["broken"]["status"] == "skipped" and "broken.json" in rows["broken"]["reason"]
+
+
+@needs_build
+def test_asking_for_a_gpu_where_there_is_none_is_bad_input(tmp_path):
+    if "cuda: on" in subprocess.run([str(PATHBENCH), "--version"], capture_output=True, text=True).stdout:
+        pytest.skip("this build has the CUDA tracer")
+    r = suite("--manifest", TEST_MANIFEST, "--devices", "gpu", "--out", tmp_path / "out", "--no-record")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--devices gpu" in r.stderr
+    assert not (tmp_path / "out").exists()
