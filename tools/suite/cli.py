@@ -110,6 +110,13 @@ def _check_db(db: str) -> None:
             raise InputError(f"--db {db}: a file tracked by git; the history database is never committed")
 
 
+def _work_dir(out: str) -> str:
+    """A hidden folder beside `out` where everything is written, moved into `out` at the end."""
+    parent = os.path.dirname(os.path.abspath(out)) or "."
+    os.makedirs(parent, exist_ok=True)
+    return tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.partial-", dir=parent)
+
+
 def _record(db: str, files: list[str], a) -> None:
     cmd = [sys.executable, "-m", "history", "record", "--db", db]
     cmd += ["--export", a.export] if a.export else []
@@ -166,28 +173,20 @@ def run(a) -> int:
             print(f"{w['name']:<20} {s['width']}x{s['height']} {s['spp']:>4} spp {flat:>11,} tri {inst:>12,} instanced  "
                   f"{w['stresses'][:60]}")
         return 0
-    if a.from_json:
-        db = None if a.no_record else (a.db or default_db())
-        if db:
-            _check_db(db)
-        stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
-        out = a.out or os.path.join(_data_home(), "pathbench", "suite", f"{stamp}-{mode}")
-        _check_out(out)
-        parent = os.path.dirname(os.path.abspath(out)) or "."
-        os.makedirs(parent, exist_ok=True)
-        work = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.partial-", dir=parent)
-        try:
-            return _from_json(a, work, out, m, chosen, mode, preset, db, None)
-        finally:
-            shutil.rmtree(work, ignore_errors=True)
-    run_devs, skipped_devs = devices.plan(exe, a.devices)
-    rank, size = devices.mpi_world()
     db = None if a.no_record else (a.db or default_db())
     if db:
         _check_db(db)
     stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
     out = a.out or os.path.join(_data_home(), "pathbench", "suite", f"{stamp}-{mode}")
     _check_out(out)
+    if a.from_json:
+        work = _work_dir(out)
+        try:
+            return _from_json(a, work, out, m, chosen, mode, preset, db, None)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+    run_devs, skipped_devs = devices.plan(exe, a.devices)
+    rank, size = devices.mpi_world()
     data = manifest.data_dir()
     runnable, skipped_rows = [], []
     for w in chosen:
@@ -202,9 +201,7 @@ def run(a) -> int:
     for d in skipped_devs:
         print(f"pathbench suite: no {d['label']}: {d['reason']}", file=sys.stderr)
 
-    parent = os.path.dirname(os.path.abspath(out)) or "."
-    os.makedirs(parent, exist_ok=True)
-    work = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.partial-", dir=parent)
+    work = _work_dir(out)
     t0 = time.monotonic()
     try:
         return _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_rows, mode, preset, db,
