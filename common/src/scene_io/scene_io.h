@@ -74,6 +74,9 @@ MeshData read_obj_mesh(const std::string& path, const std::string& text, bool wi
 MeshData read_mesh_file(const std::string& path, bool with_materials, const FileReader& read, const Losses& losses,
                         uint64_t& budget);
 
+// Triangles of `s` that its instances expanded into (they count against
+// limits::kMaxInstancedTriangles, the others against kMaxTriangles).
+uint64_t instanced_triangles(const Scene& s);
 // Appends `mesh` moved by `to_world` (winding kept; flipped too when flip_winding) and
 // returns the index of its first triangle. `materials`: triangle i's scene material
 // (one entry: every triangle's). Throws InputError past the scene's triangle limit.
