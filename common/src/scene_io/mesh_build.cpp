@@ -167,4 +167,14 @@ void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const c
   }
 }
 
+Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char* emitter_hint) {
+  Scene s;
+  s.name = path;
+  const uint32_t grey = scenes::add_material(s, "default", {0.5f, 0.5f, 0.5f});
+  append_mesh(s, mesh, Affine(), {grey});
+  frame_bare_mesh(s, path, true, emitter_hint);
+  s.finalize();
+  return s;
+}
+
 }  // namespace pb::scene_io

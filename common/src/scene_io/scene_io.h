@@ -89,5 +89,7 @@ void add_instance(Scene& s, uint32_t prototype, const Affine& to_world, bool fli
 // A scene made of a bare mesh file (OBJ, PLY, glTF without a camera): a camera framing
 // its bounds and, when nothing emits, a default area light (with a note on stderr).
 void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const char* emitter_hint);
+// A scene of one mesh without materials (PLY, OFF): grey (0.5) diffuse, framed as above.
+Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char* emitter_hint);
 
 }  // namespace pb::scene_io
