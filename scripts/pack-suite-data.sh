@@ -32,7 +32,8 @@ for line in "${files[@]}"; do
   names+=("$1")
 done
 mkdir -p "$out"
-tar -C "$data/meshes" -cJf "$out/suite-meshes.tar.xz.part" "${names[@]}"
+extra=(); [ -f "$data/meshes/SOURCE.txt" ] && extra=(SOURCE.txt)  # where they come from, their licence
+tar -C "$data/meshes" -cJf "$out/suite-meshes.tar.xz.part" "${names[@]}" "${extra[@]}"
 mv "$out/suite-meshes.tar.xz.part" "$out/suite-meshes.tar.xz"
 {
   cat <<'HEAD'

@@ -38,7 +38,7 @@ std::string off_error(const std::string& text) { return error_of([&] { off(text)
 TEST(SceneOff, TheCubeIsThePlyCube) {
   const Scene a = load_scene(kFormats + "cube.off");
   const Scene b = load_scene(kFormats + "cube-ascii.ply");
-  ASSERT_EQ(a.triangles.size(), 12u);
+  ASSERT_EQ(a.triangles.size(), 14u);  // 12 and the default light
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
   for (size_t i = 0; i < a.triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) {
@@ -74,7 +74,7 @@ TEST(SceneOff, HostileInputIsOneClearError) {
       {"OFF\n", "the file ends before the counts line"},
       {"OFF\n3 x 0\n", "face count: 'x' is not a whole number"},
       {"OFF\n3 -1 0\n", "face count: '-1' is not a whole number"},
-      {"OFF\n99999999999 1 0\n" + tri, "more than the 15 bytes left can hold"},
+      {"OFF\n99999999999 1 0\n" + tri, "more than the 18 bytes left can hold"},
       {"OFF\n3 1 0\n0 0 0\n1\n0 1 0\n3 0 1 2\n", "line 4: vertex 1: expected 'x y z', got 1 value(s)"},
       {"OFF\n3 2 0\n" + tri2 + "3 0 1 2\n", "the file ends after 1 of its 2 faces (truncated?)"},
       {"OFF\n4 1 0\n" + tri2, "the file ends after 3 of its 4 vertices (truncated?)"},

@@ -332,7 +332,7 @@ class JsonSceneReader {
     const Json& vertices = array(member(g, "vertices", field), field + ".vertices");
     const Json& indices = array(member(g, "indices", field), field + ".indices");
     const uint32_t mat = material(s, member(g, "material", field), field + ".material");
-    if (s.triangles.size() + indices.size() > limits::kMaxTriangles)
+    if (s.triangles.size() + indices.size() - instanced_triangles(s) > limits::kMaxTriangles)
       fail(field + ".indices", fmt::format("the scene has more than {} triangles (the supported maximum)",
                                            limits::kMaxTriangles));
     const uint32_t base = uint32_t(s.positions.size());

@@ -51,15 +51,11 @@ MeshData read_mesh_file(const std::string& path, bool with_materials, const File
   return read_obj_mesh(path, text, with_materials, read, losses);
 }
 
-namespace {
-
 uint64_t instanced_triangles(const Scene& s) {
   uint64_t n = 0;
   for (const SceneInstance& in : s.instances) n += in.triangle_count;
   return n;
 }
-
-}  // namespace
 
 uint32_t append_mesh(Scene& s, const MeshData& mesh, const Affine& to_world, const std::vector<uint32_t>& materials,
                      bool flip_winding) {
@@ -70,7 +66,10 @@ uint32_t append_mesh(Scene& s, const MeshData& mesh, const Affine& to_world, con
     throw InputError(fmt::format("{}: the scene has more than {} triangles with its instances expanded (the "
                                  "supported maximum)", s.name, limits::kMaxInstancedTriangles));
   const uint32_t base = uint32_t(s.positions.size()), first = uint32_t(s.triangles.size());
-  s.positions.reserve(s.positions.size() + mesh.positions.size());
+  // Geometric growth: reserving the exact size on every call (one per instance) would copy
+  // the whole array each time, quadratic in the number of instances.
+  if (const size_t need = s.positions.size() + mesh.positions.size(); need > s.positions.capacity())
+    s.positions.reserve(std::max(need, 2 * s.positions.capacity()));
   for (const Vec3f& p : mesh.positions) s.positions.push_back(to_world.point(p));
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {
     const Triangle& t = mesh.triangles[i];
@@ -166,6 +165,16 @@ void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const c
     scene_note(fmt::format("{}: no emissive material ({}); added a default area light above the model", path,
                            emitter_hint));
   }
+}
+
+Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char* emitter_hint) {
+  Scene s;
+  s.name = path;
+  const uint32_t grey = scenes::add_material(s, "default", {0.5f, 0.5f, 0.5f});
+  append_mesh(s, mesh, Affine(), {grey});
+  frame_bare_mesh(s, path, true, emitter_hint);
+  s.finalize();
+  return s;
 }
 
 }  // namespace pb::scene_io

@@ -74,6 +74,9 @@ MeshData read_obj_mesh(const std::string& path, const std::string& text, bool wi
 MeshData read_mesh_file(const std::string& path, bool with_materials, const FileReader& read, const Losses& losses,
                         uint64_t& budget);
 
+// Triangles of `s` that its instances expanded into (they count against
+// limits::kMaxInstancedTriangles, the others against kMaxTriangles).
+uint64_t instanced_triangles(const Scene& s);
 // Appends `mesh` moved by `to_world` (winding kept; flipped too when flip_winding) and
 // returns the index of its first triangle. `materials`: triangle i's scene material
 // (one entry: every triangle's). Throws InputError past the scene's triangle limit.
@@ -86,5 +89,7 @@ void add_instance(Scene& s, uint32_t prototype, const Affine& to_world, bool fli
 // A scene made of a bare mesh file (OBJ, PLY, glTF without a camera): a camera framing
 // its bounds and, when nothing emits, a default area light (with a note on stderr).
 void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const char* emitter_hint);
+// A scene of one mesh without materials (PLY, OFF): grey (0.5) diffuse, framed as above.
+Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char* emitter_hint);
 
 }  // namespace pb::scene_io
