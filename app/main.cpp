@@ -17,11 +17,13 @@
 #include "pathbench/run/world.h"
 #include "render_command.h"
 #include "reproduce_command.h"
+#include "suite_command.h"
 #include "version.h"
 
 int main(int argc, char** argv) {
   // `history` takes its own arguments (Python's argparse), so it is handed over before CLI11 parses.
   if (argc >= 2 && std::string_view(argv[1]) == "history") return pb::app::run_history(argc - 2, argv + 2);
+  if (argc >= 2 && std::string_view(argv[1]) == "suite") return pb::app::run_suite(argc - 2, argv + 2);
   CLI::App app{"pathbench: CPU/GPU path-tracing benchmark suite"};
   app.require_subcommand(1);
   app.set_version_flag("--version", [] {
@@ -44,6 +46,7 @@ int main(int argc, char** argv) {
   pb::app::add_accuracy_options(*accuracy_cmd, accuracy);
   // Listed for --help only: main() hands `history` over to tools/history before parsing.
   app.add_subcommand("history", "performance history: record runs, change points, dashboard, backfill (tools/history)");
+  app.add_subcommand("suite", "run the workload suite on every device, record it, write one page (tools/suite)");
   pb::app::CrosscheckOptions crosscheck;
   auto* crosscheck_cmd = app.add_subcommand(
       "crosscheck", "render a scene with pathbench and Mitsuba 3 and judge them per pixel (same up to noise?)");

@@ -20,7 +20,7 @@
 namespace pb::app {
 
 void add_render_options(CLI::App& cmd, RenderOptions& o) {
-  cmd.add_option("--scene", o.scene, "built-in scene name or a scene file: .json, .obj, .ply, .gltf, .glb, Mitsuba 3 .xml")
+  cmd.add_option("--scene", o.scene, "built-in scene name or a scene file: .json, .obj, .ply, .off, .gltf, .glb, Mitsuba 3 .xml")
       ->capture_default_str();
   cmd.add_flag("--strict", o.strict,
                "fail (exit 2) when the scene file holds what pathbench does not model (textures, other BSDFs or "

@@ -105,6 +105,17 @@ std::map<std::string, std::string>& film_hashes() {
 
 void record_film_hash(const std::string& benchmark, const std::string& hash) { film_hashes()[benchmark] = hash; }
 
+namespace {
+std::map<std::string, std::string>& energy_unavailable() {
+  static std::map<std::string, std::string> reasons;
+  return reasons;
+}
+}  // namespace
+
+void record_energy_unavailable(const std::string& benchmark, const std::string& reason) {
+  energy_unavailable()[benchmark] = reason;
+}
+
 std::string strict_benchmark_json(const std::string& raw, const std::string& where) {
   // Google Benchmark writes NaN for the cv of a counter that is always zero (0 / 0);
   // the tolerant parser reads it as null. Duplicate keys collapse on parsing (and no
@@ -123,6 +134,7 @@ std::string strict_benchmark_json(const std::string& raw, const std::string& whe
     ctx["film_hash"] = fmt::format("fnv1a64:{:016x}", fnv1a64(all));
     ctx["film_hashes"] = film_hashes();
   }
+  if (!energy_unavailable().empty()) ctx["energy_unavailable"] = energy_unavailable();
   return doc.dump(2) + "\n";
 }
 

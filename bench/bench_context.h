@@ -21,5 +21,8 @@ void finish_benchmark_json(const std::string& path);
 std::string strict_benchmark_json(const std::string& raw, const std::string& where);
 // Called by each render benchmark with its film's run::film_hash.
 void record_film_hash(const std::string& benchmark, const std::string& hash);
+// Why a benchmark has no energy counters (NVML/RAPL unreadable, window too short):
+// context.energy_unavailable (benchmark name -> reason).
+void record_energy_unavailable(const std::string& benchmark, const std::string& reason);
 
 }  // namespace pb::bench

@@ -40,6 +40,7 @@
 #include "materials_bench.h"
 #include "raycast_bench.h"
 #include "render_bench.h"
+#include "suite_bench.h"
 
 namespace pb::bench {
 namespace {
@@ -150,8 +151,13 @@ namespace {
 int run_benchmarks(int argc, char** argv) {
   // --preset NAME / --preset=NAME, removed from argv before Google Benchmark sees it.
   std::string preset = "quick";
+  std::string suite_cases;  // --suite-cases FILE (--preset suite, suite_bench.h)
   std::vector<char*> args;
   for (int i = 0; i < argc; ++i) {
+    if (i > 0 && std::strcmp(argv[i], "--suite-cases") == 0 && i + 1 < argc) {
+      suite_cases = argv[++i];
+      continue;
+    }
     if (i > 0 && std::strcmp(argv[i], "--preset") == 0) {
       if (i + 1 >= argc) {
         fmt::print(stderr, "pathbench-bench: --preset needs a value (quick, paper, scaling or materials)\n");
@@ -171,7 +177,14 @@ int run_benchmarks(int argc, char** argv) {
   else if (preset == "scaling") pb::bench::preset_scaling();
   else if (preset == "materials") pb::bench::preset_materials();
   else if (preset == "gpu-layouts") pb::bench::preset_gpu_layouts();
-  else {
+  else if (preset == "suite") {
+    try {
+      preset = pb::bench::preset_suite(suite_cases);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
+      return 2;
+    }
+  } else {
     fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling, materials or gpu-layouts)\n",
                preset);
     return 2;

@@ -9,6 +9,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
+#include "pathbench/run/energy.h"
 #include "pathbench/run/run.h"
 #include "bench_context.h"
 #include "bench_ranks.h"
@@ -23,6 +24,32 @@ namespace {
 void reset_peak_rss() {
   std::ofstream f("/proc/self/clear_refs");
   if (f) f << "5";
+}
+
+// The energy meter's record as counters (render_bench.h); a missing figure's reason goes
+// into the JSON's context instead (bench_context.h).
+void add_energy_counters(benchmark::State& state, const std::string& name, nlohmann::json e, uint64_t rays,
+                         uint64_t frames, double timed_seconds) {
+  run::add_energy_rates(e, rays, frames);
+  const double window = e.value("window_seconds", 0.0);
+  if (e["joules"].is_number()) {
+    state.counters["energy_joules_per_frame"] = e["joules_per_frame"].get<double>();
+    if (e["rays_per_joule"].is_number()) state.counters["rays_per_joule"] = e["rays_per_joule"].get<double>();
+    state.counters["average_watts"] = e["average_watts"].get<double>();
+    state.counters["energy_window_seconds"] = window;
+    state.counters["energy_busy_fraction"] = window > 0 ? timed_seconds / window : 0.0;
+  } else {
+    record_energy_unavailable(name, e.value("reason", std::string("unknown")));
+  }
+  if (e.contains("sm_clock_mhz")) {
+    state.counters["sm_clock_mhz_mean"] = e["sm_clock_mhz"]["mean"].get<double>();
+    state.counters["sm_clock_mhz_min"] = e["sm_clock_mhz"]["min"].get<double>();
+  }
+  if (e.contains("temperature_c")) state.counters["temperature_c_max"] = e["temperature_c"]["max"].get<double>();
+  if (e.contains("throttle_reasons") && e["throttled"].is_boolean()) {
+    state.counters["throttle_reasons"] = double(e["throttle_reasons"].get<uint64_t>());
+    state.counters["throttled"] = e["throttled"].get<bool>() ? 1.0 : 0.0;
+  }
 }
 
 uint64_t queue_bytes_of(const RunReport& r) {
@@ -56,6 +83,11 @@ void run_render(benchmark::State& state, const RenderCase& c) {
   double cpu_seconds = 0, efficiency = 0, balance = 0;
   const std::string name = render_benchmark_name(c);
   const bool ranks = bench_ranks() > 1;
+  run::RunOptions options;
+  options.energy = false;  // measured over the whole loop below, not per frame
+  double timed_seconds = 0;
+  uint64_t frames = 0;
+  run::EnergyMeter meter(s.device);
   for (auto _ : state) {
     reset_peak_rss();
     RunReport r;
@@ -63,12 +95,14 @@ void run_render(benchmark::State& state, const RenderCase& c) {
       // Over MPI ranks: one frame of every rank, timed from their common start to the
       // film reduced on rank 0 (report.seconds, and device_seconds on GPUs).
       if (ranks) render_frame_over_ranks(name, *scene, s, film, r);
-      else run::render(*scene, s, film, r);
+      else run::render(*scene, s, film, r, options);
     } catch (const std::exception& e) {
       state.SkipWithError(e.what());
       break;
     }
     state.SetIterationTime(s.device == Device::Gpu ? r.device_seconds : r.seconds);
+    timed_seconds += s.device == Device::Gpu ? r.device_seconds : r.seconds;
+    ++frames;
     rays += r.rays.total();
     paths += r.paths;
     peak_host = std::max(peak_host, r.peak_host_bytes);
@@ -81,6 +115,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
     }
     last = r;
   }
+  add_energy_counters(state, name, meter.stop(), rays, frames, timed_seconds);
   if (last.extra.contains("film_hash")) record_film_hash(name, last.extra["film_hash"].get<std::string>());
   using benchmark::Counter;
   state.counters["rays_per_second"] = Counter(double(rays), Counter::kIsRate);
@@ -114,6 +149,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
 }  // namespace
 
 std::string render_benchmark_name(const RenderCase& c) {
+  if (!c.name.empty()) return c.name;
   const RenderSettings& s = c.settings;
   return fmt::format("render/{}/{}/{}/{}x{}/spp:{}/bounces:{}/{}", to_string(s.device), to_string(s.strategy), c.scene,
                      s.width, s.height, s.spp, s.max_bounces < 0 ? std::string("unbounded") : std::to_string(s.max_bounces),

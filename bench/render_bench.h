@@ -14,6 +14,13 @@
 //   queue_bytes         bytes of the ray / path queue (wavefront pool, paper queue;
 //                       0 for pixel-parallel)
 //   pixels_x_spp, triangles, threads   the size of the job and where it ran
+//   energy (pathbench/run/energy.h), measured over each repetition's whole loop of frames
+//   (BVH builds between frames included; energy_busy_fraction = timed / window seconds):
+//     energy_joules_per_frame, rays_per_joule, average_watts, energy_window_seconds,
+//     energy_busy_fraction   where the device's counter is readable (else the reason is in
+//                            the JSON's context.energy_unavailable); GPU also
+//     sm_clock_mhz_mean, sm_clock_mhz_min, temperature_c_max, throttle_reasons (NVML's
+//     clock-event mask, OR over the samples), throttled (1: clocks lowered by power/thermal)
 #include <string>
 
 #include "pathbench/common/settings.h"
@@ -25,6 +32,7 @@ struct RenderCase {
   RenderSettings settings;  // device, strategy, size, spp, bounces, sampling
   int iterations = 0;       // fixed iteration count; 0 = Google Benchmark decides. Each
                             // iteration rebuilds the BVH (untimed), so big scenes want few.
+  std::string name;         // the benchmark's name; "" = render/<device>/... as below (the suite names its own)
 };
 
 std::string render_benchmark_name(const RenderCase& c);

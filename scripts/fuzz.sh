@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target for a bounded time and fails on any finding: a crash, a
 # sanitizer report (ASan + UBSan), a leak, a slow input (> 10 s) or one over 2 GB.
-#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | all
+#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | off | all
 # Builds build-fuzz/ with clang first (-DPATHBENCH_FUZZ=ON). The seed corpus is
 # tests/fuzz/corpus/TARGET (read only); what the fuzzer learns goes to
 # build-fuzz/corpus/TARGET and is kept between runs; a failing input is written to
@@ -10,8 +10,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
-targets="scene_json obj bench_json ply gltf mitsuba"
-target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|all SECONDS}
+targets="scene_json obj bench_json ply gltf mitsuba off"
+target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|off|all SECONDS}
 seconds=${2:?usage: scripts/fuzz.sh TARGET SECONDS}
 build=${PATHBENCH_FUZZ_BUILD:-build-fuzz}
 
@@ -25,6 +25,7 @@ case "$target" in
   scene_json|bench_json|gltf) dict=tests/fuzz/json.dict ;;
   obj) dict=tests/fuzz/obj.dict ;;
   ply) dict=tests/fuzz/ply.dict ;;
+  off) dict=tests/fuzz/off.dict ;;
   mitsuba) dict=tests/fuzz/xml.dict ;;
   *) echo "fuzz.sh: unknown target '$target' ($targets or all)" >&2; exit 2 ;;
 esac

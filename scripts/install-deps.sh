@@ -59,4 +59,6 @@ if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ] && [ "${PATHBENCH_SKIP_NCCL:-0}" != 1 ] 
   echo "[install-deps] pip install nvidia-nccl-cu13 (NCCL headers and library)"
   "$root/.venv/bin/python" -m pip install -q --no-deps nvidia-nccl-cu13==2.32.3
 fi
+# The suite's meshes (Debian libcgal-demo) into the data folder: scripts/install-suite-data.sh.
+"$root/scripts/install-suite-data.sh"
 echo "[install-deps] done"

@@ -233,6 +233,7 @@ BenchFile bench_file_from_json(const std::string& path, const nlohmann::json& j,
     } else if (b.contains("cpu_time") && b["cpu_time"].is_number()) {
       s.cpu_seconds.push_back(b["cpu_time"].get<double>() * scale);
     }
+    if (b.contains("throttled") && b["throttled"].is_number() && b["throttled"].get<double>() > 0) s.throttled = true;
     if (b.contains("label") && b["label"].is_string() && !b["label"].get<std::string>().empty())
       s.labels.insert(b["label"].get<std::string>());
     // A counter named like Google Benchmark's own "threads" key was a duplicate key in
@@ -336,6 +337,12 @@ std::vector<CompareRow> compare_files(const BenchFile& base, const BenchFile& ne
       }
       if (row.diverges && row.note.empty())
         row.note = fmt::format("wall {:+.1f}% but CPU {:+.1f}%", 100 * row.time_change, 100 * row.cpu_change);
+      // A run whose GPU lowered its clocks (power or thermal, NVML's clock-event reasons)
+      // measured the cooling, not the code: say so beside any verdict.
+      if (b.throttled || n.throttled) {
+        const std::string t = fmt::format("THROTTLED in {}", b.throttled && n.throttled ? "both" : b.throttled ? "base" : "new");
+        row.note = row.note.empty() ? t : row.note + "; " + t;
+      }
     }
     rows.push_back(row);
   }

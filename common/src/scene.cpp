@@ -3,6 +3,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "pathbench/common/errors.h"
@@ -36,9 +37,14 @@ void Scene::finalize() {
   if (material_ids.size() != triangles.size())
     throw InputError(fmt::format("{}: {} triangles but {} material ids", name, triangles.size(), material_ids.size()));
   if (materials.empty()) throw InputError(fmt::format("{}: the scene has no materials", name));
-  if (triangles.size() > limits::kMaxTriangles)
+  uint64_t instanced = 0;
+  for (const SceneInstance& in : instances) instanced += in.triangle_count;
+  if (triangles.size() - std::min<uint64_t>(instanced, triangles.size()) > limits::kMaxTriangles)
     throw InputError(fmt::format("{}: {} triangles; the supported maximum is {}", name, triangles.size(),
                                  limits::kMaxTriangles));
+  if (triangles.size() > limits::kMaxInstancedTriangles)
+    throw InputError(fmt::format("{}: {} triangles with its instances expanded; the supported maximum is {}", name,
+                                 triangles.size(), limits::kMaxInstancedTriangles));
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!finite(positions[i]))
       throw InputError(fmt::format("{}: vertex {} has a NaN or infinite coordinate ({}, {}, {})", name, i,

@@ -2,9 +2,12 @@
 
 #include <fmt/core.h>
 
+#include <optional>
+
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/cpu/render.h"
+#include "pathbench/run/energy.h"
 #include "pathbench/run/film_hash.h"
 #include "pathbench/run/run_context.h"
 #if PATHBENCH_HAVE_CUDA
@@ -53,6 +56,8 @@ void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& 
   report.triangles = scene.triangles.size();
   report.settings = s;
   const nlohmann::json start = load_sample();
+  std::optional<EnergyMeter> meter;  // around the tracer call: its build and its frame
+  if (options.energy) meter.emplace(s.device);
   if (s.device == Device::Cpu) {
     cpu::render(scene, s, film, report);
   } else {
@@ -63,6 +68,10 @@ void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& 
   // The load around the tracer alone (so that a contended run can be told from a slow
   // one) and the machine it ran on, filled here once for every caller.
   report.load = load_between(start, load_sample());
+  if (meter) {
+    report.extra["energy"] = meter->stop();
+    add_energy_rates(report.extra["energy"], report.rays.total(), 1);
+  }
   report.fingerprint = run_fingerprint(s.device == Device::Gpu);
   report.peak_host_bytes = peak_resident_bytes();
   check_discarded(scene, s, report);

@@ -106,7 +106,7 @@ TEST_F(SpecialFiles, MeshBytesAddUpPerScene) {
     "materials": {"grey": {"albedo": [0.5, 0.5, 0.5], "emission": [1, 1, 1]}},
     "meshes": [{"file": "m.obj", "material": "grey"}, {"file": "m.obj", "material": "grey"}]})");
   EXPECT_NE(error_of([&] { load_scene(path("s.json")); })
-                .find("the mesh files (OBJ, PLY) of one scene are limited to 256 MiB in all"),
+                .find("the mesh files (OBJ, PLY, OFF) of one scene are limited to 256 MiB in all"),
             std::string::npos);
 }
 

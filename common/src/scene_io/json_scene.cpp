@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "pathbench/common/scene_warnings.h"
+#include "pathbench/common/data_dir.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/json_input.h"
@@ -252,11 +253,20 @@ class JsonSceneReader {
     return a;
   }
 
-  // {"file": OBJ or PLY, "material": name (optional for an OBJ: its own MTL materials),
-  // "transform": T} or, instanced, {"file", "material", "instances": [T, T, ...]}.
+  // {"file": OBJ, PLY or OFF, "material": name (optional for an OBJ: its own MTL
+  // materials), "transform": T} or, instanced, {"file", "material", "instances": [T, T,
+  // ...]}; "subdivide": N refines the mesh N times (Loop) before it is placed. A file
+  // "data:REL" is REL in pathbench's data folder (data_dir.h), else relative to the JSON.
   void read_mesh(Scene& s, const Json& m, const std::string& field) const {
-    allow_keys(object(m, field), field, {"file", "material", "transform", "instances"});
+    allow_keys(object(m, field), field, {"file", "material", "transform", "instances", "subdivide"});
     const std::string file = string(member(m, "file", field), field + ".file");
+    int subdivide = 0;
+    if (m.contains("subdivide")) {
+      const Json& n = m["subdivide"];
+      if (!n.is_number_integer() || n.get<int64_t>() < 0 || n.get<int64_t>() > 8)
+        fail(field + ".subdivide", "expected a whole number of Loop subdivision levels from 0 to 8, got " + got(n));
+      subdivide = int(n.get<int64_t>());
+    }
     const bool own_materials = !m.contains("material");
     const uint32_t mat = own_materials ? 0 : material(s, m["material"], field + ".material");
     if (m.contains("transform") && m.contains("instances"))
@@ -270,11 +280,15 @@ class JsonSceneReader {
     } else {
       placements.push_back(m.contains("transform") ? read_transform(m["transform"], field + ".transform") : Affine());
     }
-    const fs::path path = fs::path(path_).parent_path() / file;
-    if (!read_.exists(path.string())) fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, path.string()));
+    const fs::path path = is_data_path(file) ? fs::path(resolve_data_path(file)) : fs::path(path_).parent_path() / file;
+    if (!read_.exists(path.string())) {
+      if (is_data_path(file)) fail(field + ".file", missing_data_message(file));
+      fail(field + ".file", fmt::format("'{}': no such file (looked for {})", file, path.string()));
+    }
     MeshData mesh;
     try {
       mesh = read_mesh_file(path.string(), own_materials, read_, losses_, mesh_bytes_);
+      if (subdivide > 0) mesh = loop_subdivide(mesh, subdivide);
     } catch (const InputError& e) {
       if (std::string_view(e.what()).rfind(path_ + ": ", 0) == 0) throw;  // already names this file
       fail(field, e.what());
@@ -318,7 +332,7 @@ class JsonSceneReader {
     const Json& vertices = array(member(g, "vertices", field), field + ".vertices");
     const Json& indices = array(member(g, "indices", field), field + ".indices");
     const uint32_t mat = material(s, member(g, "material", field), field + ".material");
-    if (s.triangles.size() + indices.size() > limits::kMaxTriangles)
+    if (s.triangles.size() + indices.size() - instanced_triangles(s) > limits::kMaxTriangles)
       fail(field + ".indices", fmt::format("the scene has more than {} triangles (the supported maximum)",
                                            limits::kMaxTriangles));
     const uint32_t base = uint32_t(s.positions.size());

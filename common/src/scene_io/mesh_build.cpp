@@ -38,24 +38,38 @@ FileReader disk_reader() {
 MeshData read_mesh_file(const std::string& path, bool with_materials, const FileReader& read, const Losses& losses,
                         uint64_t& budget) {
   const std::string ext = image_extension(path);  // lower case
-  if (ext != ".obj" && ext != ".ply")
-    throw InputError(fmt::format("{}: unsupported mesh file type '{}' (expected .obj or .ply)", path, ext));
-  const bool ply = ext == ".ply";
-  const std::string text = read.read(path, ply ? "mesh file (PLY)" : "mesh file (OBJ)", limits::kMaxMeshBytes);
+  if (ext != ".obj" && ext != ".ply" && ext != ".off")
+    throw InputError(fmt::format("{}: unsupported mesh file type '{}' (expected .obj, .ply or .off)", path, ext));
+  const char* what = ext == ".ply" ? "mesh file (PLY)" : ext == ".off" ? "mesh file (OFF)" : "mesh file (OBJ)";
+  const std::string text = read.read(path, what, limits::kMaxMeshBytes);
   budget += text.size();
   if (budget > limits::kMaxMeshBytes)
-    throw InputError(fmt::format("{}: the mesh files (OBJ, PLY) of one scene are limited to {} in all", path,
+    throw InputError(fmt::format("{}: the mesh files (OBJ, PLY, OFF) of one scene are limited to {} in all", path,
                                  format_bytes(limits::kMaxMeshBytes)));
-  return ply ? read_ply(path, text, losses) : read_obj_mesh(path, text, with_materials, read, losses);
+  if (ext == ".ply") return read_ply(path, text, losses);
+  if (ext == ".off") return read_off(path, text, losses);
+  return read_obj_mesh(path, text, with_materials, read, losses);
+}
+
+uint64_t instanced_triangles(const Scene& s) {
+  uint64_t n = 0;
+  for (const SceneInstance& in : s.instances) n += in.triangle_count;
+  return n;
 }
 
 uint32_t append_mesh(Scene& s, const MeshData& mesh, const Affine& to_world, const std::vector<uint32_t>& materials,
                      bool flip_winding) {
-  if (s.triangles.size() + mesh.triangles.size() > limits::kMaxTriangles)
+  if (s.triangles.size() + mesh.triangles.size() - instanced_triangles(s) > limits::kMaxTriangles)
     throw InputError(fmt::format("{}: the scene has more than {} triangles (the supported maximum)", s.name,
                                  limits::kMaxTriangles));
+  if (s.triangles.size() + mesh.triangles.size() > limits::kMaxInstancedTriangles)
+    throw InputError(fmt::format("{}: the scene has more than {} triangles with its instances expanded (the "
+                                 "supported maximum)", s.name, limits::kMaxInstancedTriangles));
   const uint32_t base = uint32_t(s.positions.size()), first = uint32_t(s.triangles.size());
-  s.positions.reserve(s.positions.size() + mesh.positions.size());
+  // Geometric growth: reserving the exact size on every call (one per instance) would copy
+  // the whole array each time, quadratic in the number of instances.
+  if (const size_t need = s.positions.size() + mesh.positions.size(); need > s.positions.capacity())
+    s.positions.reserve(std::max(need, 2 * s.positions.capacity()));
   for (const Vec3f& p : mesh.positions) s.positions.push_back(to_world.point(p));
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {
     const Triangle& t = mesh.triangles[i];
@@ -80,8 +94,14 @@ uint32_t add_prototype(Scene& s, std::string name, const MeshData& mesh, const s
 void add_instance(Scene& s, uint32_t prototype, const Affine& to_world, bool flip_winding) {
   const ScenePrototype& p = s.prototypes.at(prototype);
   MeshData geometry{p.positions, p.triangles, {}, {}, {}};
-  const uint32_t first = append_mesh(s, geometry, to_world, p.material_ids, flip_winding);
-  s.instances.push_back({prototype, to_world, first, uint32_t(p.triangles.size())});
+  // Counted as instanced before it is appended, so that only kMaxInstancedTriangles bounds it.
+  s.instances.push_back({prototype, to_world, uint32_t(s.triangles.size()), uint32_t(p.triangles.size())});
+  try {
+    append_mesh(s, geometry, to_world, p.material_ids, flip_winding);
+  } catch (...) {
+    s.instances.pop_back();
+    throw;
+  }
 }
 
 namespace {
@@ -145,6 +165,16 @@ void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const c
     scene_note(fmt::format("{}: no emissive material ({}); added a default area light above the model", path,
                            emitter_hint));
   }
+}
+
+Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char* emitter_hint) {
+  Scene s;
+  s.name = path;
+  const uint32_t grey = scenes::add_material(s, "default", {0.5f, 0.5f, 0.5f});
+  append_mesh(s, mesh, Affine(), {grey});
+  frame_bare_mesh(s, path, true, emitter_hint);
+  s.finalize();
+  return s;
 }
 
 }  // namespace pb::scene_io

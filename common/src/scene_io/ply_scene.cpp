@@ -14,7 +14,6 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
 #include "scene_io/scene_io.h"
-#include "scenes/builder.h"
 
 namespace pb::scene_io {
 
@@ -294,14 +293,7 @@ MeshData read_ply(const std::string& path, const std::string& text, const Losses
 }
 
 Scene parse_scene_ply(const std::string& path, const std::string& text, const Losses& losses) {
-  MeshData mesh = read_ply(path, text, losses);
-  Scene s;
-  s.name = path;
-  const uint32_t grey = scenes::add_material(s, "default", {0.5f, 0.5f, 0.5f});
-  append_mesh(s, mesh, Affine(), {grey});
-  frame_bare_mesh(s, path, true, "a PLY mesh has no materials");
-  s.finalize();
-  return s;
+  return bare_mesh_scene(path, read_ply(path, text, losses), "a PLY mesh has no materials");
 }
 
 }  // namespace pb::scene_io

@@ -22,13 +22,13 @@ namespace {
 // The extension in lower case (image_io's, which means the same for any file).
 std::string extension_of(const std::string& path) { return image_extension(path); }
 
-constexpr std::string_view kReadable[] = {".json", ".obj", ".ply", ".gltf", ".glb", ".xml"};
+constexpr std::string_view kReadable[] = {".json", ".obj", ".ply", ".off", ".gltf", ".glb", ".xml"};
 
 // Scene and mesh formats users may try, with their names, that pathbench does not read.
 constexpr std::pair<std::string_view, std::string_view> kOtherFormats[] = {
     {".stl", "STL"},  {".fbx", "FBX"},  {".dae", "COLLADA"}, {".3ds", "3DS"},   {".blend", "Blender"},
     {".usd", "USD"},  {".usda", "USD"}, {".usdc", "USD"},     {".usdz", "USD"}, {".pbrt", "pbrt"},
-    {".abc", "Alembic"}, {".x3d", "X3D"}, {".off", "OFF"}};
+    {".abc", "Alembic"}, {".x3d", "X3D"}};
 
 }  // namespace
 
@@ -44,6 +44,8 @@ Scene load_scene_file(const std::string& path, bool strict) {
   if (ext == ".obj") return load_scene_obj(path, strict);
   if (ext == ".ply")
     return scene_io::parse_scene_ply(path, read_input_file(path, "mesh file (PLY)", limits::kMaxMeshBytes), losses);
+  if (ext == ".off")
+    return scene_io::parse_scene_off(path, read_input_file(path, "mesh file (OFF)", limits::kMaxMeshBytes), losses);
   if (ext == ".gltf" || ext == ".glb")
     return scene_io::parse_scene_gltf(path,
                                       read_input_file(path, ext == ".glb" ? "glTF file (GLB)" : "glTF file",
@@ -54,9 +56,9 @@ Scene load_scene_file(const std::string& path, bool strict) {
                                          scene_io::disk_reader(), losses);
   for (const auto& [e, name] : kOtherFormats)
     if (ext == e)
-      throw InputError(fmt::format("{}: {} files are not read by pathbench (scene files: .json, .obj, .ply, .gltf, "
-                                   ".glb, Mitsuba 3 .xml); convert it, e.g. to PLY or glTF", path, name));
-  throw InputError(fmt::format("{}: unknown scene file type '{}' (expected .json, .obj, .ply, .gltf, .glb or Mitsuba "
+      throw InputError(fmt::format("{}: {} files are not read by pathbench (scene files: .json, .obj, .ply, .off, "
+                                   ".gltf, .glb, Mitsuba 3 .xml); convert it, e.g. to PLY or glTF", path, name));
+  throw InputError(fmt::format("{}: unknown scene file type '{}' (expected .json, .obj, .ply, .off, .gltf, .glb or Mitsuba "
                                "3 .xml)", path, ext));
 }
 

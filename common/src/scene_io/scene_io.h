@@ -44,6 +44,7 @@ Scene parse_scene_json(const std::string& path, const std::string& text, const F
 Scene parse_scene_obj(const std::string& path, const std::string& text, const FileReader& read,
                       const Losses& losses = Losses());
 Scene parse_scene_ply(const std::string& path, const std::string& text, const Losses& losses = Losses());
+Scene parse_scene_off(const std::string& path, const std::string& text, const Losses& losses = Losses());
 // .gltf (JSON; its buffers read through `read`) or .glb (binary), by `binary`.
 Scene parse_scene_gltf(const std::string& path, const std::string& text, bool binary, const FileReader& read,
                        const Losses& losses = Losses());
@@ -59,15 +60,23 @@ struct MeshData {
   std::vector<std::string> material_names;
 };
 MeshData read_ply(const std::string& path, const std::string& text, const Losses& losses);
+MeshData read_off(const std::string& path, const std::string& text, const Losses& losses);
+// Loop subdivision (Loop 1987), `levels` times: every triangle becomes four, new edge
+// points and moved old ones by Loop's weights (boundary and non-manifold edges as
+// creases: the boundary rules). Material ids follow the parent triangle.
+MeshData loop_subdivide(const MeshData& mesh, int levels);
 // An OBJ; with_materials: its MTL libraries through `read`, else none.
 MeshData read_obj_mesh(const std::string& path, const std::string& text, bool with_materials, const FileReader& read,
                        const Losses& losses);
-// A mesh file named by a scene (JSON "file", Mitsuba "filename"): .obj or .ply, read
+// A mesh file named by a scene (JSON "file", Mitsuba "filename"): .obj, .ply or .off, read
 // through `read`; `budget` is what the scene's mesh files have used so far (one limit
 // for all of them).
 MeshData read_mesh_file(const std::string& path, bool with_materials, const FileReader& read, const Losses& losses,
                         uint64_t& budget);
 
+// Triangles of `s` that its instances expanded into (they count against
+// limits::kMaxInstancedTriangles, the others against kMaxTriangles).
+uint64_t instanced_triangles(const Scene& s);
 // Appends `mesh` moved by `to_world` (winding kept; flipped too when flip_winding) and
 // returns the index of its first triangle. `materials`: triangle i's scene material
 // (one entry: every triangle's). Throws InputError past the scene's triangle limit.
@@ -80,5 +89,7 @@ void add_instance(Scene& s, uint32_t prototype, const Affine& to_world, bool fli
 // A scene made of a bare mesh file (OBJ, PLY, glTF without a camera): a camera framing
 // its bounds and, when nothing emits, a default area light (with a note on stderr).
 void frame_bare_mesh(Scene& s, const std::string& path, bool set_camera, const char* emitter_hint);
+// A scene of one mesh without materials (PLY, OFF): grey (0.5) diffuse, framed as above.
+Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char* emitter_hint);
 
 }  // namespace pb::scene_io

@@ -96,7 +96,7 @@ Scene load_scene(const std::string& spec, const SceneLoadOptions& options) {
   }
   std::string names;
   for (const auto& b : builtin_scenes()) names += (names.empty() ? "" : ", ") + b.name;
-  throw InputError(fmt::format("unknown scene '{}' (built-ins: {}; or a scene file: .json, .obj, .ply, .gltf, .glb, .xml)", spec, names));
+  throw InputError(fmt::format("unknown scene '{}' (built-ins: {}; or a scene file: .json, .obj, .ply, .off, .gltf, .glb, .xml)", spec, names));
 }
 
 }  // namespace pb

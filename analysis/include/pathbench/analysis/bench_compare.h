@@ -52,6 +52,7 @@ struct BenchSeries {
   bool cpu_is_process = false;          // from process_cpu_seconds
   std::set<std::string> labels;         // e.g. "embree_layout=quads"
   double cpu_threads = -1;              // the cpu_threads (or older threads) counter; -1: none
+  bool throttled = false;               // a repetition's "throttled" counter was 1 (GPU clocks lowered)
   bool error = false;
   std::string error_message;
 };

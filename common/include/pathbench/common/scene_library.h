@@ -20,7 +20,7 @@ struct SceneLoadOptions {
   bool strict = false;
 };
 
-// "paper-cornell", "furnace:0.5", or a scene file: .json, .obj, .ply, .gltf, .glb or
+// "paper-cornell", "furnace:0.5", or a scene file: .json, .obj, .ply, .off, .gltf, .glb or
 // Mitsuba 3 .xml. The result is finalized. Throws InputError naming the scene or file
 // (and, for a file, its format) and what is wrong.
 Scene load_scene(const std::string& name_or_path, const SceneLoadOptions& options = {});

@@ -26,6 +26,7 @@ struct RunOptions {
   bool profile = false;        // GPU: per-stage table on stdout and in report.extra["profile"]
   bool keep_variance = false;  // keep the variance sums even where settings.variance is off
   Balance balance = Balance::Auto;  // MPI ranks only
+  bool energy = true;  // energy and clocks around the tracer into report.extra["energy"] (energy.h)
 };
 
 // Renders `scene` on settings.device into `film`, which is (re)sized to the settings

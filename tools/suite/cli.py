@@ -1,0 +1,362 @@
+"""`pathbench suite`: every workload of the manifest on every device present, with enough
+repetitions for compare's U test; a progress bar and a table; bench JSON; records into the
+history database; one page (HTML + Markdown).
+
+Exit status: 0 done (skipped workloads are listed with their reason), 2 bad input (one line on
+stderr, nothing written), 3 a measurement process failed."""
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+from . import devices, manifest, page, results, runner
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REPETITIONS = 9  # `pathbench compare` refuses fewer (its U test)
+
+
+class InputError(ValueError):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2 (the project's contract)
+        raise InputError(message)
+
+
+def _data_home() -> str:
+    return os.environ.get("XDG_DATA_HOME") or os.path.join(os.path.expanduser("~"), ".local", "share")
+
+
+def default_db() -> str:
+    return os.path.join(_data_home(), "pathbench", "history.sqlite")
+
+
+def parse_args(argv):
+    ap = _Parser(prog="pathbench suite", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="small frames (minutes on 2 cores): CI and smoke tests")
+    ap.add_argument("--workloads", metavar="REGEX", help="only the workloads whose name matches")
+    ap.add_argument("--devices", metavar="LIST", help="cpu, gpu or cpu,gpu (default: every device present)")
+    ap.add_argument("--isa", choices=["auto", "avx512", "avx2", "scalar"], help="pin the CPU tracer's instruction set "
+                    "(default auto: the widest the CPU has)")
+    ap.add_argument("--repetitions", type=int, default=REPETITIONS, help="per workload and device (default 9, the "
+                    "fewest compare's U test takes)")
+    ap.add_argument("--min-time", type=float, help="seconds of frames per repetition (default: 1 on GPUs, for "
+                    "NVML's energy windows; 0.1 quick / 0.5 full on CPUs)")
+    ap.add_argument("--manifest", default=os.path.join(ROOT, "scenes", "suite", "manifest.json"))
+    ap.add_argument("--db", default=None, help=f"history database (default {default_db()})")
+    ap.add_argument("--no-record", action="store_true", help="do not record into the history database")
+    ap.add_argument("--export", help="also write the history's text export here (results/history/runs for the "
+                    "project's reference machines)")
+    ap.add_argument("--machine", help="a name for this machine in the history and on pages")
+    ap.add_argument("--references", default=os.path.join(ROOT, "results", "history", "runs"),
+                    help="the reference machines' records (the history's text export)")
+    ap.add_argument("--out", help="folder for the page and the JSON (default: "
+                    "$XDG_DATA_HOME/pathbench/suite/<date>-<mode>)")
+    ap.add_argument("--list", action="store_true", help="list the workloads and exit")
+    ap.add_argument("--from-json", nargs="+", metavar="BENCH.json", help="no measurement: the page and the records "
+                    "from the suite's bench JSON written earlier (a run cut short, another host); --quick if it was one")
+    a = ap.parse_args(argv)
+    if a.repetitions < 1:
+        raise InputError("--repetitions: must be at least 1 (9 for compare's U test)")
+    if a.min_time is not None and not (0 < a.min_time <= 3600):
+        raise InputError("--min-time: must be in (0, 3600] seconds")
+    return a
+
+
+def _exe() -> str:
+    exe = os.environ.get("PATHBENCH_EXE") or os.path.join(ROOT, "build", "bin", "pathbench")
+    if not os.access(exe, os.X_OK):
+        raise InputError(f"{exe}: no pathbench binary (build it, or run `pathbench suite` from the build)")
+    bench = os.path.join(os.path.dirname(exe), "pathbench-bench")
+    if not os.access(bench, os.X_OK):
+        raise InputError(f"{bench}: not found (build the target pathbench-bench; it needs Google Benchmark)")
+    return exe
+
+
+def _finite(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [_finite(v) for v in x]
+    return x
+
+
+def _check_out(out: str) -> None:
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise InputError(f"--out {out}: exists and is not a folder")
+    if os.path.isdir(out) and any(not n.startswith(".") for n in os.listdir(out)):
+        if not os.path.exists(os.path.join(out, "suite.json")):
+            raise InputError(f"--out {out}: a folder with other files in it (give an empty or new folder)")
+
+
+def _check_db(db: str) -> None:
+    if os.path.isdir(db):
+        raise InputError(f"--db {db}: is a folder")
+    real = os.path.realpath(db)
+    if real.startswith(ROOT + os.sep) and os.path.exists(os.path.join(ROOT, ".git")):
+        r = subprocess.run(["git", "-C", ROOT, "ls-files", "--error-unmatch", real], capture_output=True)
+        if r.returncode == 0:
+            raise InputError(f"--db {db}: a file tracked by git; the history database is never committed")
+
+
+def _work_dir(out: str) -> str:
+    """A hidden folder beside `out` where everything is written, moved into `out` at the end."""
+    parent = os.path.dirname(os.path.abspath(out)) or "."
+    os.makedirs(parent, exist_ok=True)
+    return tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.partial-", dir=parent)
+
+
+def _record(db: str, files: list[str], a) -> None:
+    cmd = [sys.executable, "-m", "history", "record", "--db", db]
+    cmd += ["--export", a.export] if a.export else []
+    cmd += ["--machine", a.machine] if a.machine else []
+    r = subprocess.run(cmd + files, capture_output=True, text=True)
+    sys.stdout.write(r.stdout)
+    if r.returncode != 0:
+        msg = (r.stderr.strip().splitlines() or ["history record failed"])[-1]
+        raise InputError(f"--db {db}: recording failed: {msg}")
+
+
+def _facts(s: dict, ctx: dict, elapsed: float, reps: int) -> list:
+    f = [("date", s["date"]), ("commit", (ctx.get("git_revision") or "unknown")[:12]),
+         ("CPU", f"{ctx.get('cpu_model', '?')} ({ctx.get('cpu_hardware_threads', '?')} threads)")]
+    gpus = sorted({r["device_name"] for r in s["rows"] if r["device"].startswith("gpu") and r.get("device_name")})
+    f.append(("GPU", ", ".join(gpus) if gpus else "none"))
+    f += [("repetitions", reps), ("manifest", s["manifest_sha256"][:12])]
+    if elapsed is not None:
+        f.append(("took", f"{elapsed / 60:.1f} min"))
+    return f
+
+
+def _table(rows: list[dict]) -> str:
+    head = f"{'workload':<22} {'device':<8} {'ms/frame':>10} {'Mrays/s':>9} {'Msmp/s':>8} {'MiB':>7} {'J/frame':>9} " \
+           f"{'Mrays/J':>8} {'throttle':>8}  vs previous"
+    out = [head, "-" * len(head)]
+    for r in rows:
+        if r["status"] != "ok":
+            out.append(f"{r['workload']:<22} {r['device']:<8} skipped: {r.get('reason', '')}")
+            continue
+        def n(v, scale=1.0, fmt="{:.4g}"):
+            return "-" if v is None else fmt.format(v * scale)
+        prev = r.get("previous") or {}
+        vs = f"{prev['verdict']} {prev['change'] * 100:+.1f}%" if "change" in prev else "-"
+        th = "-" if r.get("throttled") is None else ("YES" if r["throttled"] else "no")
+        mem = max(r.get("peak_host_bytes") or 0, r.get("peak_device_bytes") or 0) / 2**20
+        out.append(f"{r['workload']:<22} {r['device']:<8} {n(r['ms']):>10} {n(r['rays_per_second'], 1e-6):>9} "
+                   f"{n(r['samples_per_second'], 1e-6):>8} {mem:>7.0f} {n(r.get('joules_per_frame')):>9} "
+                   f"{n(r.get('rays_per_joule'), 1e-6):>8} {th:>8}  {vs}")
+    return "\n".join(out)
+
+
+def run(a) -> int:
+    exe = _exe()
+    bench = os.path.join(os.path.dirname(exe), "pathbench-bench")
+    m = manifest.load(a.manifest)
+    chosen = manifest.select(m, a.workloads)
+    mode = "quick" if a.quick else "full"
+    preset = "suite-quick" if a.quick else "suite"
+    if a.list:
+        for w in chosen:
+            s = manifest.run_settings(w, a.quick)
+            flat, inst = manifest.triangle_estimate(w, manifest.data_dir(), a.quick)
+            print(f"{w['name']:<20} {s['width']}x{s['height']} {s['spp']:>4} spp {flat:>11,} tri {inst:>12,} instanced  "
+                  f"{w['stresses'][:60]}")
+        return 0
+    db = None if a.no_record else (a.db or default_db())
+    if db:
+        _check_db(db)
+    stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+    out = a.out or os.path.join(_data_home(), "pathbench", "suite", f"{stamp}-{mode}")
+    _check_out(out)
+    if a.from_json:
+        work = _work_dir(out)
+        try:
+            return _from_json(a, work, out, m, chosen, mode, preset, db, None)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+    run_devs, skipped_devs = devices.plan(exe, a.devices)
+    rank, size = devices.mpi_world()
+    data = manifest.data_dir()
+    runnable, skipped_rows = [], []
+    for w in chosen:
+        why = manifest.missing_requirement(w, data)
+        if why:
+            for d in run_devs:
+                skipped_rows.append({"workload": w["name"], "device": d["label"], "status": "skipped",
+                                     "reason": f"workload {w['name']} {why}"})
+            print(f"pathbench suite: skipped {w['name']}: {why}", file=sys.stderr)
+        else:
+            runnable.append(w)
+    for d in skipped_devs:
+        print(f"pathbench suite: no {d['label']}: {d['reason']}", file=sys.stderr)
+
+    work = _work_dir(out)
+    t0 = time.monotonic()
+    try:
+        return _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_rows, mode, preset, db,
+                       stamp, rank, size, t0)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_rows, mode, preset, db, stamp, rank, size, t0):
+    groups = [[d] for d in run_devs]
+    if size > 1:  # under mpirun: one pathbench-bench for every device, its frames over the ranks
+        groups = [[dict(d, label=f"ranks{size}-{d['label']}") for d in run_devs]]
+    plans = []
+    for g in groups:
+        cases, label = [], "-".join(d["label"] for d in g)
+        for d in g:
+            cases += runner.cases_for(runnable, d, a.quick, a.isa, manifest.data_dir())
+        plans.append((g, label, cases))
+    total = sum(len(c) for _, _, c in plans) * a.repetitions
+    progress = runner.Progress(total)
+    rows, bench_files, ctx = list(skipped_rows), [], {}
+    with open(os.path.join(work, "bench.log"), "w") as log:
+        for g, label, cases in plans:
+            if not cases:
+                continue
+            min_time = a.min_time or (1.0 if any(d["device"] == "gpu" for d in g) else (0.1 if a.quick else 0.5))
+            doc = {"suite": "pathbench", "version": m["version"], "mode": mode, "manifest_sha256": m["sha256"],
+                   "device_label": label, "cases": [{k: c[k] for k in ("name", "scene", "device", "settings")} |
+                                                    ({"iterations": c["iterations"]} if "iterations" in c else {})
+                                                    for c in cases]}
+            env = dict(g[0]["env"]) if len(g) == 1 else {}
+            env["PATHBENCH_DATA_DIR"] = manifest.data_dir()
+            rc, path = runner.run_device(bench, doc, work, label, a.repetitions, min_time, env, progress, log)
+            if rank != 0:
+                continue
+            if rc == 2:
+                progress.close()
+                raise InputError(f"pathbench-bench refused the suite's cases for {label} (see {out}/bench.log)")
+            if rc != 0 or not os.path.exists(path):
+                progress.close()
+                print(f"pathbench suite: failed: pathbench-bench for {label} exited with {rc}", file=sys.stderr)
+                return 3
+            bench_doc = runner.read_bench_json(path)
+            ctx = ctx or bench_doc.get("context", {})
+            final = os.path.join(work, f"suite-{stamp}-{label}.json")
+            os.replace(path, final)
+            bench_files.append(final)
+            for d in g:
+                rows += results.rows_from_bench(bench_doc, [c for c in cases if c["device"] == d["device"]], d)
+    progress.close()
+    if rank != 0:
+        return 0
+    return _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t0)
+
+
+def _from_json(a, work, out, m, chosen, mode, preset, db, t0) -> int:
+    """--from-json: the page and the records from bench JSON an earlier run wrote (a run cut
+    short, or one made on another host): no measurement."""
+    rows, files, ctx = [], [], {}
+    names = {w["name"]: w for w in chosen}
+    for path in a.from_json:
+        try:
+            doc = _finite(runner.read_bench_json(path, strict=False))
+        except (OSError, ValueError) as e:
+            raise InputError(f"--from-json {path}: not readable bench JSON ({e})") from None
+        if not isinstance(doc, dict) or not isinstance(doc.get("benchmarks"), list):
+            raise InputError(f"--from-json {path}: not Google Benchmark JSON")
+        ctx = ctx or doc.get("context", {})
+        seen = {}
+        for b in doc["benchmarks"]:
+            parts = str(b.get("run_name", b.get("name", ""))).split("/")
+            if len(parts) >= 4 and parts[0] == "suite" and parts[1] in names:
+                seen.setdefault((parts[1], parts[2], parts[3]), None)
+        for (wl, label, strategy) in seen:
+            dev = {"label": label, "device": "gpu" if "gpu" in label else "cpu",
+                   "name": doc.get("context", {}).get("gpu_name", "") if "gpu" in label else "CPU"}
+            case = runner.cases_for([names[wl]], dev, mode == "quick", None, manifest.data_dir())[0]
+            rows += results.rows_from_bench(doc, [case], dev)
+        dest = os.path.join(work, os.path.basename(path))
+        shutil.copyfile(path, dest)
+        files.append(dest)
+    have = {r["workload"] for r in rows}
+    for w in chosen:
+        if w["name"] not in have:
+            rows.append({"workload": w["name"], "device": "-", "status": "skipped",
+                         "reason": "not measured: no result for it in the bench JSON given"})
+    return _report(a, work, out, m, chosen, rows, files, ctx, mode, preset, db, t0)
+
+
+def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t0) -> int:
+    order = {w["name"]: i for i, w in enumerate(chosen)}
+    rows.sort(key=lambda r: (order.get(r["workload"], 0), r["device"]))
+    if db:
+        os.makedirs(os.path.dirname(os.path.abspath(db)), exist_ok=True)
+        _record(db, bench_files, a)
+        prev = results.previous_runs(db, [os.path.basename(f) for f in bench_files], preset)
+        for r in rows:
+            p = prev.get(r.get("benchmark", ""))
+            if p and r["status"] == "ok":
+                r["previous"] = results.verdict(r["times_ms"], p["times_ms"]) | {"run_date": p["run_date"],
+                                                                                 "commit": p["commit"]}
+    sources = {os.path.basename(f) for f in bench_files}
+    refs = results.reference_runs(a.references, preset, sources) if a.references and os.path.isdir(a.references) else {}
+    ref_names = sorted(n for n, per in refs.items() if any(r.get("benchmark") in per for r in rows))
+    for r in rows:
+        for n in ref_names:
+            ref = refs[n].get(r.get("benchmark", ""))
+            if ref:
+                r.setdefault("references", {})[n] = {"ms": results._median(ref["times_ms"]), "run_date": ref["run_date"],
+                                                     "commit": ref["commit"]}
+    name = a.machine or ctx.get("machine", "this machine")
+    gpus = sorted({r.get("device_name") for r in rows if r["device"].startswith("gpu") and r.get("device_name")})
+    if gpus and not a.machine:
+        name = f"{', '.join(gpus)} ({name} host)"
+    summary = {"suite": "pathbench", "version": m["version"], "mode": mode, "preset": preset,
+               "date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+               "machine": {"name": name, "machine_id": ctx.get("machine_id"), "cpu": ctx.get("cpu_model"),
+                           "fingerprint": ctx.get("fingerprint")},
+               "git_revision": ctx.get("git_revision"), "manifest": os.path.relpath(m["path"], ROOT)
+               if m["path"].startswith(ROOT) else m["path"], "manifest_sha256": m["sha256"],
+               "repetitions": a.repetitions, "db": db, "reference_machines": ref_names,
+               "command": "pathbench suite " + " ".join(sys.argv[1:]),
+               "bench_json": [os.path.basename(f) for f in bench_files], "rows": rows,
+               "workloads": [dict(w, run_settings=manifest.run_settings(w, a.quick),
+                                  triangles=max(w["triangles"], manifest.triangle_estimate(w, manifest.data_dir(), a.quick)[0]),
+                                  instanced_triangles=max(w["instanced_triangles"],
+                                                          manifest.triangle_estimate(w, manifest.data_dir(), a.quick)[1]))
+                             for w in chosen]}
+    summary["facts"] = _facts(summary, ctx, None if t0 is None else time.monotonic() - t0, a.repetitions)
+    summary = _finite(summary)
+    with open(os.path.join(work, "suite.json"), "w") as f:
+        json.dump(summary, f, indent=1, allow_nan=False)
+        f.write("\n")
+    page.write_html(os.path.join(work, "index.html"), summary)
+    page.write_markdown(os.path.join(work, "suite.md"), summary)
+    os.makedirs(out, exist_ok=True)
+    for n in os.listdir(work):
+        os.replace(os.path.join(work, n), os.path.join(out, n))
+    print(_table(rows))
+    print(f"\npage: {os.path.join(out, 'index.html')} (and suite.md, suite.json, the bench JSON)")
+    return 0
+
+
+def main(argv=None) -> int:
+    try:
+        return run(parse_args(argv if argv is not None else sys.argv[1:]))
+    except (InputError, manifest.ManifestError, devices.DeviceError) as e:
+        print(f"pathbench suite: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("pathbench suite: interrupted; nothing written", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # `pathbench suite --list | head`
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except OSError as e:
+        print(f"pathbench suite: failed: {e}", file=sys.stderr)
+        return 3
