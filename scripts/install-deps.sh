@@ -28,6 +28,9 @@ if ((${#missing[@]})); then
 else
   echo "[install-deps] apt packages: all present"
 fi
+# The suite's meshes (Debian libcgal-demo) into the data folder: scripts/install-suite-data.sh.
+"$root/scripts/install-suite-data.sh" ||
+  echo "[install-deps] warning: the suite's meshes are not installed (above); the workloads that need them are skipped"
 
 if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
   if [ ! -x "$root/.venv/bin/python" ]; then
@@ -50,7 +53,4 @@ if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
     echo "[install-deps] .venv: up to date"
   fi
 fi
-# The suite's meshes (Debian libcgal-demo) into the data folder: scripts/install-suite-data.sh.
-"$root/scripts/install-suite-data.sh" ||
-  echo "[install-deps] warning: the suite's meshes are not installed (above); the workloads that need them are skipped"
 echo "[install-deps] done"
