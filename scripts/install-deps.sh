@@ -28,6 +28,9 @@ if ((${#missing[@]})); then
 else
   echo "[install-deps] apt packages: all present"
 fi
+# The suite's meshes (Debian libcgal-demo) into the data folder: scripts/install-suite-data.sh.
+"$root/scripts/install-suite-data.sh" ||
+  echo "[install-deps] warning: the suite's meshes are not installed (above); the workloads that need them are skipped"
 
 if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ]; then
   if [ ! -x "$root/.venv/bin/python" ]; then
@@ -59,6 +62,4 @@ if [ "${PATHBENCH_SKIP_VENV:-0}" != 1 ] && [ "${PATHBENCH_SKIP_NCCL:-0}" != 1 ] 
   echo "[install-deps] pip install nvidia-nccl-cu13 (NCCL headers and library)"
   "$root/.venv/bin/python" -m pip install -q --no-deps nvidia-nccl-cu13==2.32.3
 fi
-# The suite's meshes (Debian libcgal-demo) into the data folder: scripts/install-suite-data.sh.
-"$root/scripts/install-suite-data.sh"
 echo "[install-deps] done"
