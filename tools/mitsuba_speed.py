@@ -164,6 +164,12 @@ def raw_embree_result(raw_rounds, pb, ours):
     return out
 
 
+def too_short(res):
+    """The renderers whose timings hold a zero (a frame too small to time), by name."""
+    named = {"mitsuba": res["mitsuba"]} | {f"pathbench {s}": r for s, r in res["pathbench"].items()}
+    return [name for name, r in named.items() if min(r["seconds"]) <= 0]
+
+
 def add_rates(res, a):
     samples = a.size * a.size * a.spp
     m = res["mitsuba"]
@@ -229,6 +235,10 @@ def main(argv=None):
             emulate, shim, mitsuba.emulation["drjit"], mitsuba.emulation["embree"],
             {s: r["embree"] for s, r in pb.items()}, (bench_context.get("fingerprint") or {}).get("embree"),
             {s: r["isa"] for s, r in pb.items()}, (first.get("fingerprint") or {}).get("build"))
+    if too_short(res):
+        print(f"mitsuba_speed.py: error: {', '.join(too_short(res))}: a render took 0 s (the frame is too small to "
+              "time); raise --size or --spp", file=sys.stderr)
+        return 2
     add_rates(res, a)
 
     out = Path(a.out_dir) if a.out_dir else ROOT / "results" / res["machine"]["slug"]

@@ -10,10 +10,11 @@ machine fingerprint (tools/machine.py), so the history keys the machine by it.""
 from __future__ import annotations
 
 import os
-import statistics
 import subprocess
 import sys
 from pathlib import Path
+
+from mitsuba_speed_report import round_medians
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -23,13 +24,6 @@ def series_name(res, label):
     em = res.get("emulation")
     return (f"mitsuba/cpu/{s['scene']}/{s['width']}x{s['height']}/spp:{s['spp']}/bounces:{s['bounces']}/"
             f"{s['sampling']}/{label}" + (f"/emulate:{em['isa']}" if em else ""))
-
-
-def _round_medians(runs):
-    out = {}
-    for r in runs:
-        out.setdefault(r["round"], []).append(r["seconds"])
-    return {k: statistics.median(v) for k, v in out.items()}
 
 
 def bench_json(res, date_iso):
@@ -43,10 +37,10 @@ def bench_json(res, date_iso):
         "load_average_before": res["load_average_before"], "load_average_after": res["load_average_after"],
         "settings": res["settings"],
     }
-    m_round = _round_medians(m["runs"])
+    m_round = round_medians(m["runs"])
     rows = []
     for label, r in res["pathbench"].items():
-        p_round = _round_medians(r["runs"])
+        p_round = round_medians(r["runs"])
         for i, k in enumerate(sorted(m_round.keys() & p_round.keys())):
             rows.append({
                 "name": series_name(res, label), "run_type": "iteration", "repetition_index": i, "iterations": 1,

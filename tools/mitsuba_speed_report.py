@@ -21,15 +21,18 @@ def spread(values):
     return {k: (x if k == "n" else round(x, 3)) for k, x in r.items()}
 
 
+def round_medians(runs):
+    """{round: the median seconds of the runs in it}."""
+    out = {}
+    for r in runs:
+        out.setdefault(r["round"], []).append(r["seconds"])
+    return {k: statistics.median(v) for k, v in out.items()}
+
+
 def round_speedups(mitsuba_runs, pathbench_runs):
     """Per round: the median of Mitsuba's renders in it over the median of pathbench's in it,
     rounds where both rendered; the range of these is the ratio's spread."""
-    def by_round(runs):
-        out = {}
-        for r in runs:
-            out.setdefault(r["round"], []).append(r["seconds"])
-        return {k: statistics.median(v) for k, v in out.items()}
-    m, p = by_round(mitsuba_runs), by_round(pathbench_runs)
+    m, p = round_medians(mitsuba_runs), round_medians(pathbench_runs)
     return [round(m[k] / p[k], 3) for k in sorted(m.keys() & p.keys()) if p[k] > 0]
 
 

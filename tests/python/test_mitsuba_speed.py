@@ -113,11 +113,17 @@ def test_markdown_shows_the_spread_and_the_ratio_range():
     assert "| 1.74x (1.50–2.00x) |" in md
 
 
+def test_a_render_timed_at_zero_is_named():
+    res = _result()
+    res["mitsuba"]["seconds"], res["pathbench"]["wavefront/no-watertight"]["seconds"] = [1.0, 2.0], [0.0, 0.1]
+    assert mitsuba_speed.too_short(res) == ["pathbench wavefront/no-watertight"]
+
+
 @pytest.mark.skipif(not EXE.exists(), reason="build/bin/pathbench not built")
 def test_a_tiny_run_end_to_end(tmp_path):
     pytest.importorskip("mitsuba")
     db = tmp_path / "h.sqlite"
-    r = subprocess.run([sys.executable, str(ROOT / "tools" / "mitsuba_speed.py"), "--size", "8", "--spp", "2",
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "mitsuba_speed.py"), "--size", "16", "--spp", "16",
                         "--rounds", "2", "--mitsuba-per-round", "2", "--strategies", "wavefront", "--no-raw",
                         "--out-dir", str(tmp_path), "--history-db", str(db)], capture_output=True, text=True)
     if r.returncode != 0 and "libLLVM" in r.stderr + r.stdout:
