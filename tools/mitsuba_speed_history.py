@@ -29,9 +29,10 @@ def series_name(res, label):
 def bench_json(res, date_iso):
     """The results as Google-Benchmark-shaped JSON (context + one row per series and round)."""
     m = res["mitsuba"]
-    first = next(iter(res["pathbench"].values()))
+    rev = next(iter(res["pathbench"].values())).get("git_revision") or ""
     context = {
-        "date": date_iso, "git_revision": first.get("git_revision"), "machine": res["machine"]["slug"],
+        # "abc123-dirty": the commit, and the tree had changes (the history keys runs by the commit)
+        "date": date_iso, "git_revision": rev.removesuffix("-dirty") or None, "git_dirty": rev.endswith("-dirty"), "machine": res["machine"]["slug"],
         "cpu_model": res["machine"]["cpu"], "fingerprint": res["fingerprint"],
         "pathbench_preset": "mitsuba-speed", "mitsuba": f"{m['renderer']} {m['variant']}",
         "load_average_before": res["load_average_before"], "load_average_after": res["load_average_after"],

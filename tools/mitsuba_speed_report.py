@@ -54,6 +54,9 @@ def write_json(path: Path, obj):
     try:
         with os.fdopen(fd, "w") as f:
             f.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as open() would make it, not mkstemp's 0600
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -61,7 +64,7 @@ def write_json(path: Path, obj):
         raise
 
 
-def layout_lines(pb):
+def layout_lines(pb, raw=False):
     """Which Embree layout each pathbench run traced (`--embree-layout auto` decides per
     process, from a probe it times), so the table says what was measured."""
     parts = []
@@ -76,7 +79,7 @@ def layout_lines(pb):
     if not parts:
         return []
     return ["pathbench's Embree layout (`--embree-layout " + next(iter(pb.values()))["embree_layout"]["asked"]
-            + "`; the raw rates above come from the same choice): " + "; ".join(parts) + "."]
+            + "`" + ("; the raw rates above come from the same choice" if raw else "") + "): " + "; ".join(parts) + "."]
 
 
 def _timing_cells(r):
@@ -157,7 +160,7 @@ def markdown(res):
         "now answers the last continuation ray with an emitter test and traces fewer rays per sample (rays/s counts "
         "only rays traced). `no-watertight`: Embree without its robust mode (faster; rays can slip through edges).",
         f"Image means (R, G, B): Mitsuba {m['image_mean_rgb']}, pathbench {first['image_mean_rgb']}.",
-        *layout_lines(pb),
+        *layout_lines(pb, bool(res.get("raw_embree"))),
         f"pathbench revision {first['git_revision']}, {first['compiler']}.",
         "",
         "Re-run: `.venv/bin/python tools/mitsuba_speed.py"

@@ -62,6 +62,9 @@ def test_write_json_is_strict_and_leaves_nothing_half_written(tmp_path):
         report.write_json(f, {"a": math.nan})
     assert json.loads(f.read_text()) == {"a": 1.5}  # the old file stays whole
     assert [p.name for p in tmp_path.iterdir()] == ["r.json"]  # no temporary left
+    umask = os.umask(0)
+    os.umask(umask)
+    assert f.stat().st_mode & 0o777 == 0o666 & ~umask
 
 
 def _result():
@@ -79,6 +82,7 @@ def _result():
 def test_history_rows_hold_the_ratio_and_both_medians():
     b = mitsuba_speed_history.bench_json(_result(), "2026-01-01T00:00:00+00:00")
     assert b["context"]["fingerprint"]["machine_id"] == "0123"
+    assert b["context"]["git_revision"] == "HEAD" and b["context"]["git_dirty"] is False
     rows = b["benchmarks"]
     assert [r["name"] for r in rows] == ["mitsuba/cpu/paper-cornell/16x16/spp:4/bounces:2/nee/wavefront/no-watertight"] * 2
     assert [r["repetition_index"] for r in rows] == [0, 1]
@@ -111,6 +115,13 @@ def test_markdown_shows_the_spread_and_the_ratio_range():
     assert "| Mitsuba 3.9.1 llvm_ad_rgb | 11.50 | 10.00–12.00 | 1.25 | 4 |" in md
     assert "| pathbench cpu/wavefront/no-watertight | 6.62 | 5.25–8.00 | 1.38 | 2 |" in md
     assert "| 1.74x (1.50–2.00x) |" in md
+
+
+def test_a_dirty_tree_is_recorded_at_its_commit():
+    res = _result()
+    res["pathbench"]["wavefront/no-watertight"]["git_revision"] = "5a7952c7a307-dirty"
+    ctx = mitsuba_speed_history.bench_json(res, "2026-01-01T00:00:00+00:00")["context"]
+    assert ctx["git_revision"] == "5a7952c7a307" and ctx["git_dirty"] is True
 
 
 def test_a_render_timed_at_zero_is_named():
