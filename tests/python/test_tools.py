@@ -69,8 +69,11 @@ def test_speed_markdown_names_the_embree_layout():
         "asked": "auto", "used": "quads", "why": "quads measured faster",
         "probe_ns_per_ray": {"triangles": 94.0, "quads": 68.0}}
     md = mitsuba_speed.markdown(res)
-    assert ("pathbench's Embree layout (`--embree-layout auto`; the raw rates above come from the same choice): "
+    assert ("pathbench's Embree layout (`--embree-layout auto`): "
             "pixel: quads (quads measured faster, probe 94 ns/ray as triangles, 68 as quads).") in md
+    assert "raw rates above" not in md  # none measured (--no-raw): none referred to
+    res["raw_embree"] = {"rates": {}, "rounds": 1, "mix": {}}
+    assert "(`--embree-layout auto`; the raw rates above come from the same choice): " in mitsuba_speed.markdown(res)
 
 
 def _rates(camera, bounce, shadow, width):
