@@ -47,35 +47,8 @@ std::string_view gltf_json_text(const std::string& path, const std::string& text
 }
 
 void check_gltf_json_shape(const std::string& path, std::string_view json) {
-  uint64_t values = 1, depth = 0;  // values: the root, one per comma, one per container
-  bool in_string = false;
-  for (size_t i = 0; i < json.size(); ++i) {
-    const char c = json[i];
-    if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
-      continue;
-    }
-    switch (c) {
-      case '"': in_string = true; break;
-      case '[':
-      case '{':
-        if (++depth > uint64_t(kMaxJsonDepth))
-          throw InputError(fmt::format("{}: glTF: JSON nested deeper than {} levels (the supported maximum)", path,
-                                       kMaxJsonDepth));
-        [[fallthrough]];
-      case ',':
-        if (++values > limits::kMaxGltfJsonValues)
-          throw InputError(fmt::format("{}: glTF: more than {} JSON values (the supported maximum)", path,
-                                       limits::kMaxGltfJsonValues));
-        break;
-      case ']':
-      case '}':
-        if (depth > 0) --depth;
-        break;
-      default: break;
-    }
-  }
+  // Keys per object are not bounded here: tinygltf's objects are std::maps.
+  check_json_bounds(json, path, {kMaxJsonDepth, SIZE_MAX, limits::kMaxGltfJsonValues});
 }
 
 }  // namespace pb::scene_io
