@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pathbench/common/errors.h"
+#include "test_scene_helpers.h"
 #include "pathbench/common/json_input.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_warnings.h"
@@ -23,14 +24,7 @@ namespace {
 
 using scene_io::FileReader;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
+using scene_test::error_of;
 
 // Buffer files resolve to `bin`; nothing else exists.
 FileReader memory_files(const std::string& bin = "") {
