@@ -179,7 +179,7 @@ TEST(GltfLimits, SharedNodesAreCountedBeforeTheyArePlaced) {
             std::string::npos);
   // A cycle, and a chain deeper than the limit.
   EXPECT_EQ(error_of([&] { load_gltf(gltf("", "", R"([{"children": [1]}, {"children": [0], "mesh": 0}])")); }),
-            "t.gltf: glTF: the node hierarchy has a cycle (through node 0)");
+            "t.gltf: glTF: the node hierarchy has a cycle (node 0 is on it or below it)");
   std::string chain = "[";
   for (int i = 0; i < 70; ++i) chain += "{\"children\": [" + std::to_string(i + 1) + "]}, ";
   chain += R"({"mesh": 0}])";

@@ -218,7 +218,7 @@ class GltfReader {
     if (done < reachable) {
       size_t on_cycle = 0;
       while (!(reached[on_cycle] && parents[on_cycle] > 0)) ++on_cycle;
-      fail(fmt::format("the node hierarchy has a cycle (through node {})", on_cycle));
+      fail(fmt::format("the node hierarchy has a cycle (node {} is on it or below it)", on_cycle));
     }
   }
 
