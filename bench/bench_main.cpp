@@ -10,6 +10,7 @@
 //   scaling  rays/s vs triangle count (scaling:N, N = 10 .. 10^7), time vs spp and
 //            vs resolution (paper-cornell); Embree ray casts on every scaling:N.
 //   materials  diffuse-only against mirror/glass/GGX scenes (materials_bench.h).
+//   loading  scene-file loading time against placements, fitted to O(N) (loading_bench.h).
 //   gpu-layouts  the GPU BVH layouts side by side (bvh_layout.h): raw ray casts in each
 //            layout on paper-cornell, paper-cornell-ico:0/1/2 (34, 94, 334 triangles:
 //            where brute force stops paying) and paper-cornell-ico:8 (1.31 M).
@@ -37,6 +38,7 @@
 #if PATHBENCH_BENCH_GPU
 #include "pathbench/bvh/bvh_layout.h"
 #endif
+#include "loading_bench.h"
 #include "materials_bench.h"
 #include "raycast_bench.h"
 #include "render_bench.h"
@@ -177,15 +179,18 @@ int run_benchmarks(int argc, char** argv) {
   else if (preset == "scaling") pb::bench::preset_scaling();
   else if (preset == "materials") pb::bench::preset_materials();
   else if (preset == "gpu-layouts") pb::bench::preset_gpu_layouts();
+  else if (preset == "loading") pb::bench::preset_loading();
   else if (preset == "suite") {
     try {
       preset = pb::bench::preset_suite(suite_cases);
     } catch (const std::exception& e) {
-      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
+      fmt::print(stderr, "pathbench-bench: {}
+", e.what());
       return 2;
     }
   } else {
-    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling, materials or gpu-layouts)\n",
+    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling, materials, gpu-layouts, loading or suite)
+",
                preset);
     return 2;
   }

@@ -22,7 +22,8 @@ if [ "$target" = all ]; then
   exit 0
 fi
 case "$target" in
-  scene_json|bench_json|gltf) dict=tests/fuzz/json.dict ;;
+  scene_json|bench_json) dict=tests/fuzz/json.dict ;;
+  gltf) dict=tests/fuzz/gltf.dict ;;
   obj) dict=tests/fuzz/obj.dict ;;
   ply) dict=tests/fuzz/ply.dict ;;
   off) dict=tests/fuzz/off.dict ;;

@@ -11,6 +11,7 @@
 #include <iterator>
 
 #include "pathbench/common/errors.h"
+#include "test_scene_helpers.h"
 #include "pathbench/common/scene_library.h"
 
 namespace pb {
@@ -45,14 +46,7 @@ void expect_same_scene(const Scene& a, const Scene& b, float tol) {
   EXPECT_EQ(a.emitters, b.emitters);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using scene_test::error_of;
 
 class TempDir : public testing::Test {
  protected:

@@ -2,11 +2,23 @@
 // Small helpers shared by the scene tests (test_scene_builtins.cpp, test_scene_files.cpp).
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
+#include "pathbench/common/errors.h"
 #include "pathbench/common/scene.h"
 
 namespace pb::scene_test {
+
+// The message of the InputError that f throws, or "(no InputError)".
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
 
 inline Vec3f normal_of(const Scene& s, const Triangle& t) {
   const Vec3f a = s.positions[t.v[0]], b = s.positions[t.v[1]], c = s.positions[t.v[2]];

@@ -14,6 +14,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
 #include "scene_io/gltf_config.h"
+#include "scene_io/gltf_input.h"
 #include "scene_io/scene_io.h"
 #include "scenes/builder.h"
 
@@ -75,7 +76,8 @@ class GltfReader {
     } else {
       for (size_t i = 0; i < model_.nodes.size(); ++i) roots.push_back(int(i));  // no scene: every node
     }
-    for (int root : roots) visit(s, root, Affine(), 0);
+    count_placements(roots);
+    for (int root : roots) visit(s, root, Affine());
     if (s.triangles.empty()) fail("the scene has no triangle meshes");
     frame_bare_mesh(s, path_, !have_camera_, "emissiveFactor");
     if (have_camera_) s.camera = camera_;
@@ -91,7 +93,6 @@ class GltfReader {
   std::vector<uint32_t> scene_material_;  // glTF material -> Scene material (+1 slot: the default)
   bool have_camera_ = false;
   Camera camera_{};
-  uint64_t visits_ = 0;
 
   [[noreturn]] void fail(const std::string& what) const { throw InputError(fmt::format("{}: glTF: {}", path_, what)); }
 
@@ -126,24 +127,117 @@ class GltfReader {
     return a;
   }
 
-  void visit(Scene& s, int index, const Affine& parent, int depth) {
-    if (index < 0 || size_t(index) >= model_.nodes.size()) fail(fmt::format("node {} does not exist", index));
-    // glTF node graphs are trees; a cycle or a huge fan-out of shared children is refused.
-    if (depth > 64) fail("the node hierarchy is more than 64 levels deep (a cycle?)");
-    if (++visits_ > (uint64_t(1) << 20)) fail("more than 2^20 node placements");
+  static uint64_t add_sat(uint64_t a, uint64_t b) { return a + b < a ? UINT64_MAX : a + b; }
+  static uint64_t mul_sat(uint64_t a, uint64_t b) {
+    uint64_t r = 0;
+    return __builtin_mul_overflow(a, b, &r) ? UINT64_MAX : r;
+  }
+
+  // Triangles and vertices one placement of a mesh adds, from its accessors' counts
+  // (make_prototype reads and checks the accessors themselves later).
+  std::pair<uint64_t, uint64_t> mesh_size(const tinygltf::Mesh& m) const {
+    auto count = [&](int a) -> uint64_t { return a >= 0 && size_t(a) < model_.accessors.size() ? model_.accessors[size_t(a)].count : 0; };
+    uint64_t triangles = 0, vertices = 0;
+    for (const tinygltf::Primitive& p : m.primitives) {
+      if (p.mode < 4 || p.mode > 6) continue;
+      const auto pos = p.attributes.find("POSITION");
+      const uint64_t nv = pos == p.attributes.end() ? 0 : count(pos->second);
+      const uint64_t ni = p.indices >= 0 ? count(p.indices) : nv;
+      triangles = add_sat(triangles, p.mode == TINYGLTF_MODE_TRIANGLES ? ni / 3 : ni < 3 ? 0 : ni - 2);
+      vertices = add_sat(vertices, nv);
+    }
+    return {triangles, vertices};
+  }
+
+  // How often each node is placed, before any geometry is read: once per path from a
+  // root to it. glTF's node graph is a set of trees, but tinygltf does not check that,
+  // and 31 nodes each naming the next twice as a child place the last 2^30 times. So
+  // the paths are counted (in topological order, saturating; a cycle is refused), and
+  // the placements, triangles and vertices they make are checked against the limits.
+  void count_placements(const std::vector<int>& roots) const {
+    const size_t n = model_.nodes.size();
+    auto check = [&](int i) {
+      if (i < 0 || size_t(i) >= n) fail(fmt::format("node {} does not exist", i));
+      return size_t(i);
+    };
+    // The nodes reachable from the roots, and their parents among them (per use).
+    std::vector<uint32_t> parents(n, 0);
+    std::vector<char> reached(n, 0);
+    std::vector<size_t> stack;
+    size_t reachable = 0;
+    for (int r : roots)
+      if (const size_t i = check(r); !reached[i]) reached[i] = 1, ++reachable, stack.push_back(i);
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      for (int child : model_.nodes[i].children) {
+        const size_t c = check(child);
+        ++parents[c];
+        if (!reached[c]) reached[c] = 1, ++reachable, stack.push_back(c);
+      }
+    }
+    const uint64_t cap = limits::kMaxPlacements + 1;  // counts saturate here
+    std::vector<uint64_t> count(n, 0);
+    std::vector<int> depth(n, 0);
+    for (int r : roots) count[size_t(r)] = std::min(cap, count[size_t(r)] + 1);
+    std::vector<size_t> ready;
+    for (size_t i = 0; i < n; ++i)
+      if (reached[i] && parents[i] == 0) ready.push_back(i);
+    uint64_t placements = 0, triangles = 0, vertices = 0;
+    size_t done = 0;
+    while (!ready.empty()) {
+      const size_t i = ready.back();
+      ready.pop_back();
+      ++done;
+      const tinygltf::Node& node = model_.nodes[i];
+      placements = std::min(cap, placements + count[i]);
+      if (placements > limits::kMaxPlacements)
+        fail(fmt::format("the node hierarchy places nodes more than {} times (the supported maximum; a node that is "
+                         "the child of several nodes is placed once per path to it)", limits::kMaxPlacements));
+      if (node.mesh >= 0) {
+        if (size_t(node.mesh) >= model_.meshes.size())
+          fail(fmt::format("node '{:.60}': mesh {} does not exist", node.name, node.mesh));
+        const auto [t, v] = mesh_size(model_.meshes[size_t(node.mesh)]);
+        triangles = add_sat(triangles, mul_sat(t, count[i]));
+        vertices = add_sat(vertices, mul_sat(v, count[i]));
+        if (triangles > limits::kMaxTriangles)
+          fail(fmt::format("the placed meshes have more than {} triangles in all (the supported maximum; mesh {} is "
+                           "placed {} time{})", limits::kMaxTriangles, node.mesh, count[i], count[i] == 1 ? "" : "s"));
+        if (vertices > limits::kMaxVertices)
+          fail(fmt::format("the placed meshes have more than {} vertices in all (the supported maximum; mesh {} is "
+                           "placed {} time{})", limits::kMaxVertices, node.mesh, count[i], count[i] == 1 ? "" : "s"));
+      }
+      for (int child : node.children) {
+        const size_t c = size_t(child);
+        count[c] = std::min(cap, count[c] + count[i]);
+        if ((depth[c] = std::max(depth[c], depth[i] + 1)) > kMaxDepth)
+          fail(fmt::format("the node hierarchy is more than {} levels deep (the supported maximum)", kMaxDepth));
+        if (--parents[c] == 0) ready.push_back(c);
+      }
+    }
+    if (done < reachable) {
+      size_t on_cycle = 0;
+      while (!(reached[on_cycle] && parents[on_cycle] > 0)) ++on_cycle;
+      fail(fmt::format("the node hierarchy has a cycle (node {} is on it or below it)", on_cycle));
+    }
+  }
+
+  // visit() recurses per level: count_placements has bounded the depth.
+  static constexpr int kMaxDepth = 64;
+
+  void visit(Scene& s, int index, const Affine& parent) {
     const tinygltf::Node& n = model_.nodes[size_t(index)];
     const Affine to_world = parent * local(n);
     if (!to_world.finite()) fail(fmt::format("node '{:.60}': the transform is not finite", n.name));
     if (n.camera >= 0) place_camera(n, to_world);
     if (n.mesh >= 0) {
-      if (size_t(n.mesh) >= model_.meshes.size()) fail(fmt::format("node '{:.60}': mesh {} does not exist", n.name, n.mesh));
       if (prototype_of_mesh_[size_t(n.mesh)] < 0) prototype_of_mesh_[size_t(n.mesh)] = int(make_prototype(s, size_t(n.mesh)));
       if (!(std::fabs(to_world.determinant()) > 0)) fail(fmt::format("node '{:.60}': the transform is singular", n.name));
       // A mirroring transform reverses the winding, as the glTF specification says, so
       // that front faces (and one-sided emitters) stay in front.
       add_instance(s, uint32_t(prototype_of_mesh_[size_t(n.mesh)]), to_world, to_world.determinant() < 0);
     }
-    for (int child : n.children) visit(s, child, to_world, depth + 1);
+    for (int child : n.children) visit(s, child, to_world);
   }
 
   void place_camera(const tinygltf::Node& n, const Affine& to_world) {
@@ -237,13 +331,21 @@ class GltfReader {
     const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
     if (v.buffer < 0 || size_t(v.buffer) >= model_.buffers.size()) fail(fmt::format("{}: buffer {} does not exist", what, v.buffer));
     const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
-    const size_t element = size * size_t(components);
-    const size_t stride = v.byteStride ? v.byteStride : element;
+    const uint64_t element = size * uint64_t(components);
+    const uint64_t stride = v.byteStride ? v.byteStride : element;
     if (stride < element) fail(fmt::format("{}: byteStride {} is below the element size {}", what, stride, element));
-    // In 64 bits: count <= 3 * 2^24 and stride <= 2^8 cannot overflow.
-    const uint64_t need = uint64_t(a.byteOffset) + uint64_t(stride) * (a.count - 1) + element;
-    if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset || need > v.byteLength)
-      fail(fmt::format("{}: accessor {} reaches past the end of its buffer", what, index));
+    // The bytes read are [byteOffset, byteOffset + stride * (count - 1) + element) of the
+    // view, and the view [byteOffset, byteOffset + byteLength) of the buffer. Every sum
+    // and product is checked: offsets near 2^64 must not wrap past the check to a read
+    // before or after the buffer.
+    uint64_t end = 0;
+    if (__builtin_mul_overflow(stride, uint64_t(a.count - 1), &end) || __builtin_add_overflow(end, element, &end) ||
+        __builtin_add_overflow(end, uint64_t(a.byteOffset), &end) || v.byteOffset > data.size() ||
+        v.byteLength > data.size() - v.byteOffset || end > v.byteLength)
+      fail(fmt::format("{}: accessor {} (byteOffset {}, {} elements of stride {}) reaches outside its bufferView {} "
+                       "(byteOffset {}, byteLength {}) or buffer {} ({} bytes)",
+                       what, index, a.byteOffset, a.count, stride, a.bufferView, v.byteOffset, v.byteLength, v.buffer,
+                       data.size()));
     const unsigned char* base = data.data() + v.byteOffset + a.byteOffset;
     out.reserve(a.count * size_t(components));
     for (size_t i = 0; i < a.count; ++i)
@@ -285,6 +387,11 @@ class GltfReader {
       else for (uint32_t i = 0; i < nv; ++i) idx.push_back(i);
       for (double i : idx)
         if (i >= nv) fail(fmt::format("{}: index {} is out of range ({} vertices)", what, i, nv));
+      // The triangles this adds, refused before they are made (count_placements has
+      // checked the scene's total from the same accessors' counts).
+      const uint64_t adds = p.mode == TINYGLTF_MODE_TRIANGLES ? idx.size() / 3 : idx.size() < 3 ? 0 : idx.size() - 2;
+      if (mesh.triangles.size() + adds > limits::kMaxTriangles)
+        fail(fmt::format("more than {} triangles: the supported maximum per scene", limits::kMaxTriangles));
       const uint32_t mat = material(s, p.material);
       auto tri = [&](size_t a, size_t b, size_t c) {
         mesh.triangles.push_back({{base + uint32_t(idx[a]), base + uint32_t(idx[b]), base + uint32_t(idx[c])}});
@@ -298,8 +405,6 @@ class GltfReader {
       } else {
         for (size_t i = 1; i + 1 < idx.size(); ++i) tri(0, i, i + 1);
       }
-      if (mesh.triangles.size() > limits::kMaxTriangles)
-        fail(fmt::format("more than {} triangles: the supported maximum per scene", limits::kMaxTriangles));
     }
     return add_prototype(s, m.name.empty() ? fmt::format("mesh{}", mesh_index) : m.name, mesh, mats);
   }
@@ -317,9 +422,17 @@ Scene parse_scene_gltf(const std::string& path, const std::string& text, bool bi
   std::string err, warn;
   const std::string dir = fs::path(path).parent_path().string();
   if (text.size() > limits::kMaxMeshBytes) throw InputError(fmt::format("{}: glTF files are limited to {}", path, limits::kMaxMeshBytes));
-  const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(text.data()),
-                                                       unsigned(text.size()), dir)
-                         : loader.LoadASCIIFromString(&model, &err, &warn, text.data(), unsigned(text.size()), dir);
+  check_gltf_json_shape(path, gltf_json_text(path, text, binary));
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(text.data()),
+                                              unsigned(text.size()), dir)
+                : loader.LoadASCIIFromString(&model, &err, &warn, text.data(), unsigned(text.size()), dir);
+  } catch (const std::logic_error& e) {
+    // tinygltf 2.7 indexes with at() where it did not check a size (a GLB buffer of
+    // byteLength 0: data.at(0)); nothing was read out of bounds.
+    throw InputError(fmt::format("{}: malformed glTF: {:.200}", path, e.what()));
+  }
   if (!ctx.error.empty()) throw InputError(ctx.error);
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == '.')) err.pop_back();

@@ -76,8 +76,9 @@ class JsonSceneReader {
   std::string path_;
   const FileReader& read_;
   const Losses& losses_;
-  mutable uint64_t mesh_bytes_ = 0;
-  mutable std::unordered_map<std::string, uint32_t> material_index_;  // name -> first material of that name  // all mesh files read so far: one budget for the scene
+  mutable uint64_t mesh_bytes_ = 0;  // all mesh files read so far: one budget for the scene
+  mutable std::unordered_map<std::string, uint32_t> material_index_;  // name -> first material of that name
+  mutable size_t indexed_ = 0;  // materials in material_index_ (the first ones)
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
     if (field.empty()) throw InputError(fmt::format("{}: {}", path_, what));
@@ -132,11 +133,10 @@ class JsonSceneReader {
   }
   uint32_t material(const Scene& s, const Json& j, const std::string& field) const {
     const std::string name = string(j, field);
-    // A map, not a search per use: many groups times many materials stays linear.
-    if (material_index_.size() != s.material_names.size()) {
-      material_index_.clear();
-      for (size_t i = 0; i < s.material_names.size(); ++i) material_index_.emplace(s.material_names[i], uint32_t(i));
-    }
+    // A map, not a search per use: many groups times many materials stays linear. It
+    // takes in only the materials added since (meshes with their own MTL materials add
+    // some between lookups): rebuilding it whole made those scenes quadratic.
+    for (; indexed_ < s.material_names.size(); ++indexed_) material_index_.emplace(s.material_names[indexed_], uint32_t(indexed_));
     if (auto it = material_index_.find(name); it != material_index_.end()) return it->second;
     std::string known;
     for (const std::string& n : s.material_names) {
@@ -275,6 +275,10 @@ class JsonSceneReader {
     if (m.contains("instances")) {
       const Json& list = array(m["instances"], field + ".instances");
       if (list.empty()) fail(field + ".instances", "is empty: give at least one transform");
+      if (s.instances.size() + list.size() > limits::kMaxPlacements)
+        fail(field + ".instances", fmt::format("{} more placements: the scene may place meshes at most {} times in all "
+                                               "(the supported maximum)", list.size(), limits::kMaxPlacements));
+      placements.reserve(list.size());
       for (size_t i = 0; i < list.size(); ++i)
         placements.push_back(read_transform(list[i], fmt::format("{}.instances[{}]", field, i)));
     } else {

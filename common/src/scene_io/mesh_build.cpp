@@ -57,22 +57,44 @@ uint64_t instanced_triangles(const Scene& s) {
   return n;
 }
 
-uint32_t append_mesh(Scene& s, const MeshData& mesh, const Affine& to_world, const std::vector<uint32_t>& materials,
-                     bool flip_winding) {
-  if (s.triangles.size() + mesh.triangles.size() - instanced_triangles(s) > limits::kMaxTriangles)
-    throw InputError(fmt::format("{}: the scene has more than {} triangles (the supported maximum)", s.name,
-                                 limits::kMaxTriangles));
-  if (s.triangles.size() + mesh.triangles.size() > limits::kMaxInstancedTriangles)
+namespace {
+
+// Room for `more` elements, growing geometrically: reserving exactly size() + more
+// for each placed mesh reallocates (copies the scene) on every placement, which made
+// loading quadratic in the placements (issue 34: 4,096 Mitsuba spheres took > 30 s).
+template <class T> void reserve_more(std::vector<T>& v, size_t more) {
+  if (v.capacity() - v.size() < more) v.reserve(std::max(v.size() + more, 2 * v.capacity()));
+}
+
+// `instanced`: the geometry is one placement of a prototype. Triangles outside instances stay
+// under kMaxTriangles (in a scene without instances, its vertices under kMaxVertices); with
+// the instances expanded the scene may hold up to kMaxInstancedTriangles (and three vertices
+// a triangle).
+uint32_t append_geometry(Scene& s, const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles,
+                         const Affine& to_world, const std::vector<uint32_t>& materials, bool flip_winding,
+                         bool instanced) {
+  if (s.triangles.size() + triangles.size() > limits::kMaxInstancedTriangles)
     throw InputError(fmt::format("{}: the scene has more than {} triangles with its instances expanded (the "
                                  "supported maximum)", s.name, limits::kMaxInstancedTriangles));
+  if (s.positions.size() + positions.size() > 3 * limits::kMaxInstancedTriangles)
+    throw InputError(fmt::format("{}: the scene has more than {} vertices with its instances expanded (the "
+                                 "supported maximum)", s.name, 3 * limits::kMaxInstancedTriangles));
+  if (!instanced) {
+    const uint64_t flat = s.triangles.size() - instanced_triangles(s);
+    if (flat + triangles.size() > limits::kMaxTriangles)
+      throw InputError(fmt::format("{}: the scene has more than {} triangles (the supported maximum)", s.name,
+                                   limits::kMaxTriangles));
+    if (s.positions.size() + positions.size() > limits::kMaxVertices && s.instances.empty())
+      throw InputError(fmt::format("{}: the scene has more than {} vertices (the supported maximum)", s.name,
+                                   limits::kMaxVertices));
+  }
   const uint32_t base = uint32_t(s.positions.size()), first = uint32_t(s.triangles.size());
-  // Geometric growth: reserving the exact size on every call (one per instance) would copy
-  // the whole array each time, quadratic in the number of instances.
-  if (const size_t need = s.positions.size() + mesh.positions.size(); need > s.positions.capacity())
-    s.positions.reserve(std::max(need, 2 * s.positions.capacity()));
-  for (const Vec3f& p : mesh.positions) s.positions.push_back(to_world.point(p));
-  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-    const Triangle& t = mesh.triangles[i];
+  reserve_more(s.positions, positions.size());
+  reserve_more(s.triangles, triangles.size());
+  reserve_more(s.material_ids, triangles.size());
+  for (const Vec3f& p : positions) s.positions.push_back(to_world.point(p));
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    const Triangle& t = triangles[i];
     const uint32_t mat = materials.size() == 1 ? materials[0] : materials.at(i);
     if (flip_winding)
       scenes::add_triangle(s, base + t.v[0], base + t.v[2], base + t.v[1], mat);
@@ -80,6 +102,13 @@ uint32_t append_mesh(Scene& s, const MeshData& mesh, const Affine& to_world, con
       scenes::add_triangle(s, base + t.v[0], base + t.v[1], base + t.v[2], mat);
   }
   return first;
+}
+
+}  // namespace
+
+uint32_t append_mesh(Scene& s, const MeshData& mesh, const Affine& to_world, const std::vector<uint32_t>& materials,
+                     bool flip_winding) {
+  return append_geometry(s, mesh.positions, mesh.triangles, to_world, materials, flip_winding, false);
 }
 
 uint32_t add_prototype(Scene& s, std::string name, const MeshData& mesh, const std::vector<uint32_t>& materials) {
@@ -92,16 +121,13 @@ uint32_t add_prototype(Scene& s, std::string name, const MeshData& mesh, const s
 }
 
 void add_instance(Scene& s, uint32_t prototype, const Affine& to_world, bool flip_winding) {
+  if (s.instances.size() >= limits::kMaxPlacements)
+    throw InputError(fmt::format("{}: more than {} placed instances (the supported maximum)", s.name,
+                                 limits::kMaxPlacements));
   const ScenePrototype& p = s.prototypes.at(prototype);
-  MeshData geometry{p.positions, p.triangles, {}, {}, {}};
-  // Counted as instanced before it is appended, so that only kMaxInstancedTriangles bounds it.
-  s.instances.push_back({prototype, to_world, uint32_t(s.triangles.size()), uint32_t(p.triangles.size())});
-  try {
-    append_mesh(s, geometry, to_world, p.material_ids, flip_winding);
-  } catch (...) {
-    s.instances.pop_back();
-    throw;
-  }
+  // The prototype's own arrays, not a copy per placement.
+  const uint32_t first = append_geometry(s, p.positions, p.triangles, to_world, p.material_ids, flip_winding, true);
+  s.instances.push_back({prototype, to_world, first, uint32_t(p.triangles.size())});
 }
 
 namespace {

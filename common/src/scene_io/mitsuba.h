@@ -4,9 +4,11 @@
 // whatever a reader did not ask for can be named as not modelled.
 #include <pugixml.hpp>
 
+#include <cstdint>
 #include <map>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "pathbench/common/affine.h"
@@ -20,6 +22,9 @@ struct Document {
   const Losses* losses;
   std::map<std::string, std::string> defaults;     // <default name value>: "$name" in attributes
   std::map<std::string, pugi::xml_node> ids;        // id -> element (bsdf, shapegroup, ...)
+  // Bytes of <default> values substituted so far (attr), at most kMaxExpandedBytes.
+  static constexpr uint64_t kMaxExpandedBytes = uint64_t(64) << 20;
+  mutable uint64_t expanded = 0;
 
   [[noreturn]] void fail(const pugi::xml_node& at, const std::string& what) const;
   // An attribute with "$name" replaced by its <default>; "" when absent.
@@ -58,7 +63,7 @@ class Props {
 };
 
 // Numbers separated by commas and/or blanks.
-std::vector<double> numbers(const Document& doc, const pugi::xml_node& at, const std::string& text);
+std::vector<double> numbers(const Document& doc, const pugi::xml_node& at, std::string_view text);
 
 // <bsdf> (or the element a <ref> names) -> pathbench material, with losses reported.
 Material read_bsdf(const Document& doc, pugi::xml_node bsdf, int depth = 0);
@@ -66,6 +71,7 @@ Material read_bsdf(const Document& doc, pugi::xml_node bsdf, int depth = 0);
 // Mitsuba's built-in shapes as meshes in their own coordinates.
 MeshData rectangle_mesh();                       // [-1, 1]^2 at z = 0, facing +z
 MeshData cube_mesh();                            // [-1, 1]^3, facing out
-MeshData sphere_mesh(Vec3f centre, float radius);  // tessellated, facing out
+MeshData sphere_mesh(Vec3f centre, float radius);  // tessellated (kSphereTriangles), facing out
+inline constexpr uint32_t kSphereTriangles = 4096;
 
 }  // namespace pb::scene_io::mitsuba

@@ -136,9 +136,18 @@ MeshData cube_mesh() {
 }
 
 MeshData sphere_mesh(Vec3f centre, float radius) {
-  Scene s;
-  scenes::append_uv_sphere(s, centre, radius, 64, 32, 0);  // 4096 triangles
-  return {s.positions, s.triangles, {}, {}, {}};
+  // The unit sphere is tessellated once; each sphere scales and moves it (the same
+  // floats as tessellating it there: centre + unit * radius).
+  static const MeshData unit = [] {
+    Scene s;
+    scenes::append_uv_sphere(s, {0, 0, 0}, 1.0f, 64, 32, 0);
+    return MeshData{s.positions, s.triangles, {}, {}, {}};
+  }();
+  static_assert(2 * 64 * 32 == kSphereTriangles);
+  MeshData m{{}, unit.triangles, {}, {}, {}};
+  m.positions.reserve(unit.positions.size());
+  for (const Vec3f& p : unit.positions) m.positions.push_back(centre + p * radius);
+  return m;
 }
 
 }  // namespace pb::scene_io::mitsuba

@@ -37,13 +37,18 @@ std::string Document::attr(const pugi::xml_node& n, const char* name) const {
     const std::string key = v.substr(i + 1, j - i - 1);
     const auto it = defaults.find(key);
     if (it == defaults.end()) fail(n, fmt::format("'${:.40}' has no <default name=\"{:.40}\">", key, key));
+    // "$a$a$a..." of a long default multiplies it: the text substituted for "$name"s
+    // is bounded per document (a legitimate scene substitutes a few bytes at a time).
+    if ((expanded += it->second.size()) > kMaxExpandedBytes)
+      fail(n, fmt::format("the <default> values substituted for '$name's add up to more than {} bytes (the supported "
+                          "maximum)", kMaxExpandedBytes));
     out += it->second;
     i = j;
   }
   return out;
 }
 
-std::vector<double> numbers(const Document& doc, const pugi::xml_node& at, const std::string& text) {
+std::vector<double> numbers(const Document& doc, const pugi::xml_node& at, std::string_view text) {
   std::vector<double> out;
   for (size_t i = 0; i < text.size();) {
     while (i < text.size() && (text[i] == ',' || std::isspace(static_cast<unsigned char>(text[i])))) ++i;
@@ -54,7 +59,7 @@ std::vector<double> numbers(const Document& doc, const pugi::xml_node& at, const
     const char* b = text.data() + i + (text[i] == '+' ? 1 : 0);
     auto [p, ec] = std::from_chars(b, text.data() + j, v);
     if (ec != std::errc() || p != text.data() + j || !std::isfinite(v))
-      doc.fail(at, fmt::format("'{:.40}' is not a finite number", text.substr(i, j - i)));
+      doc.fail(at, fmt::format("'{:.40}' is not a finite number", std::string(text.substr(i, j - i))));
     out.push_back(v);
     if (out.size() > 64) doc.fail(at, "more than 64 numbers in one value");
     i = j;
@@ -147,16 +152,17 @@ Vec3f Props::colour(const std::string& name, Vec3f fallback) {
   const std::string tag = n.name();
   const std::string value = doc_.attr(n, "value");
   if (tag == "spectrum" && value.find(':') != std::string::npos) {
-    // "400:0.1, 500:0.2, ...": the mean of the values, as a grey.
+    // "400:0.1, 500:0.2, ...": the mean of the values, as a grey. A view moves along
+    // the list: copying the rest after each entry made a long list quadratic.
     doc_.losses->report(doc_.path, fmt::format("spectrum '{:.40}' given by wavelength (its mean is used)", name));
     double sum = 0;
-    int count = 0;
-    std::string rest = value;
-    for (size_t c; (c = rest.find(':')) != std::string::npos;) {
-      size_t end = rest.find_first_of(", ", c);
-      const auto v = numbers(doc_, n, rest.substr(c + 1, end == std::string::npos ? std::string::npos : end - c - 1));
+    uint64_t count = 0;
+    std::string_view rest = value;
+    for (size_t c; (c = rest.find(':')) != std::string_view::npos;) {
+      const size_t end = rest.find_first_of(", ", c);
+      const auto v = numbers(doc_, n, rest.substr(c + 1, end == std::string_view::npos ? std::string_view::npos : end - c - 1));
       if (v.size() == 1) sum += v[0], ++count;
-      rest = end == std::string::npos ? "" : rest.substr(end + 1);
+      rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
     }
     const float g = count ? float(sum / count) : 0.0f;
     return {g, g, g};

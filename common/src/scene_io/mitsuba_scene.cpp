@@ -53,6 +53,9 @@ class MitsubaReader {
         doc_.losses->report(doc_.path, fmt::format("{} at the top of the scene", Document::describe(n)));
       }
     }
+    if (spheres_)
+      scene_warning(fmt::format("{}: {} <shape type=\"sphere\">{} tessellated into {} triangles each (pathbench traces "
+                                "triangles only)", doc_.path, spheres_, spheres_ == 1 ? "" : "s", mitsuba::kSphereTriangles));
     if (!have_sensor) doc_.fail(root, "the scene has no <sensor type=\"perspective\"> (pathbench needs its camera)");
     if (s.triangles.empty()) doc_.fail(root, "the scene has no shapes with triangles");
     s.finalize();
@@ -63,6 +66,7 @@ class MitsubaReader {
   Document& doc_;
   const FileReader& read_;
   uint64_t mesh_bytes_ = 0;
+  uint64_t spheres_ = 0;  // said once, after reading (not a line per sphere)
   std::map<std::string, uint32_t> prototype_of_group_;
 
   // <default>s and ids, anywhere (ids are referenced before or after their definition).
@@ -199,8 +203,7 @@ class MitsubaReader {
       const float radius = float(p.number("radius", 1));
       if (!(radius > 0)) doc_.fail(n, "the radius must be above 0");
       mesh = mitsuba::sphere_mesh(p.point("center", {0, 0, 0}), radius);
-      scene_warning(fmt::format("{}: {}: tessellated into {} triangles (pathbench traces triangles only)", doc_.path,
-                                Document::describe(n), mesh.triangles.size()));
+      ++spheres_;
     } else {
       doc_.losses->report(doc_.path, fmt::format("shape '{:.30}' (obj, ply, rectangle, cube, sphere and instance only)", type));
       return;

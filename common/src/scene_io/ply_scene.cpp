@@ -236,6 +236,8 @@ class PlyReader {
                        left));
     if (e.name == "face" && e.count > limits::kMaxTriangles)
       fail(fmt::format("{} faces: more than the supported {} triangles", e.count, limits::kMaxTriangles));
+    if (e.name == "vertex" && e.count > limits::kMaxVertices)
+      fail(fmt::format("{} vertices: more than the supported {}", e.count, limits::kMaxVertices));
   }
 
   void skip_space() {

@@ -31,6 +31,22 @@ inline constexpr uint64_t kMaxTriangles = uint64_t(1) << 24;
 // triangles needs a large machine. Triangles outside instances stay under kMaxTriangles.
 inline constexpr uint64_t kMaxInstancedTriangles = uint64_t(1) << 28;
 
+// Vertices in one scene: three per triangle at most are ever used, so a file that
+// declares more (a PLY vertex element, glTF POSITION accessors) is refused before
+// they are read.
+inline constexpr uint64_t kMaxVertices = 3 * kMaxTriangles;
+
+// Placements in one scene: instances of a mesh (JSON "instances", Mitsuba instance
+// shapes) and glTF node placements (a node shared by several parents is placed once
+// per path to it). Counted before any geometry is read, so a small file cannot ask
+// for 2^31 copies.
+inline constexpr uint64_t kMaxPlacements = uint64_t(1) << 20;
+
+// glTF's JSON (a .gltf, or a .glb's JSON chunk) before tinygltf parses it: nesting
+// depth (its parser recurses per level) and values (a parsed value costs it ~200
+// bytes, a node ~700 bytes and ~10 us): at most kMaxGltfJsonValues.
+inline constexpr uint64_t kMaxGltfJsonValues = uint64_t(1) << 20;
+
 // A render fails (exit 2, no output) when more than this fraction of its samples was
 // discarded (NaN, infinite, or beyond the film's fixed-point range): the image would
 // be wrong, not noisy.
