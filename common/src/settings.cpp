@@ -130,4 +130,20 @@ void RenderSettings::validate() const {
                                             height));
 }
 
+// The strategy/precision/watertight limits of each device's tracer (were checked in
+// cpu/src/render.cpp and gpu/src/render.cu; same messages).
+void validate_for_tracer(const RenderSettings& s, Device tracer) {
+  if (tracer == Device::Cpu) {
+    if (s.strategy == Strategy::PaperQueue)
+      throw InputError(
+          "--strategy paper-queue: the paper's global queue is a GPU strategy; the CPU runs pixel or wavefront");
+    return;
+  }
+  if (s.strategy != Strategy::Pixel && s.precision != Precision::Float)
+    throw InputError(fmt::format("--precision {}: the GPU runs double precision with --strategy pixel only (its "
+                                 "wavefront state is float4 arrays)", to_string(s.precision)));
+  if (s.strategy != Strategy::Pixel && !s.watertight)
+    throw InputError("--no-watertight: the GPU runs the Moeller-Trumbore triangle test with --strategy pixel only");
+}
+
 }  // namespace pb

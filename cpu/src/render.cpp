@@ -40,8 +40,6 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
 
 void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings& settings, Film& film,
             RunReport& report) {
-  if (settings.strategy == Strategy::PaperQueue)
-    throw InputError("--strategy paper-queue: the paper's global queue is a GPU strategy; the CPU runs pixel or wavefront");
   if (film.width() != settings.width || film.height() != settings.height)
     throw std::logic_error("film size does not match the settings");
   const Isa isa = resolve_isa(settings.isa);  // InputError where the CPU lacks the asked ISA

@@ -99,29 +99,53 @@ void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings&
 }
 
 namespace {
-void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
-                 RunReport& report, bool profile, DeviceFilm* keep) {
-  if (film.width() != settings.width || film.height() != settings.height)
-    throw std::logic_error("film size does not match the settings");
-  const DeviceInfo info = device_info();  // the device was checked by the run layer (cached)
-  const GpuScene::Impl& g = gpu_scene.impl();
-  DeviceMemory& mem = DeviceMemory::instance();
+// 1. Setup: the film on the device (this render's own, or a kept one that earlier renders,
+// an MPI rank's chunks, added into, allocated and warmed up by the first of them), and the
+// strategy's resources sized for the render's samples. The run layer has checked the
+// settings for the GPU (validate_for_tracer) and the device (device_info is cached).
+struct RenderSetup {
+  RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& s, const Film& film, bool profile,
+              DeviceFilm* keep);
+  // The kernels of the settings' strategy over `n` of the render's samples.
+  FrameResult run_frame(uint64_t n, bool variance);
 
-  const PathConfig config = settings.path_config();
-  const uint32_t pixels = settings.width * settings.height;
+  const RenderSettings& settings;
+  const DeviceInfo info = device_info();
+  const GpuScene::Impl& g;
+  const PathConfig config;
   // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share):
   // the kernels map g to (pixel g / spp, sample config.first_sample + g % spp).
-  const uint64_t total = settings.traced_samples();
-  const uint32_t spp = settings.traced_spp();
-  const ShadowUse shadows = ShadowUse::of(scene, settings);
+  const uint64_t total;
+  const uint32_t spp;
+  const ShadowUse shadows;
 
   ScopedStream stream;
-  Launcher launch(stream.s, profile);
-  // The film on the device: this render's own, or a kept one that earlier renders (an MPI
-  // rank's chunks) added into, allocated and warmed up by the first of them.
+  Launcher launch;
   FilmBuffers own;
-  FilmBuffers& fb = keep ? keep->impl().fb : own;
-  const bool first_use = !keep || !keep->impl().used;
+  FilmBuffers& fb;
+  const bool first_use;
+
+  std::vector<std::unique_ptr<PathPool>> pools;  // wavefront: wavefront_pools(...) of them; paper-queue: one
+  std::vector<std::unique_ptr<ScopedStream>> pool_streams;  // the wavefront's pools beyond the first
+  DeviceBuffer<PixelCounters> pixel_counters;
+  uint64_t warmup_total;
+  PixelOccupancy occupancy;
+  std::vector<PathPool*> pool_ptrs;
+  std::vector<cudaStream_t> pool_stream_ids;  // pool k's stream: the render's, then pool_streams
+};
+
+RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& s, const Film& film,
+                         bool profile, DeviceFilm* keep)
+    : settings(s),
+      g(gpu_scene.impl()),
+      config(s.path_config()),
+      total(s.traced_samples()),
+      spp(s.traced_spp()),
+      shadows(ShadowUse::of(scene, s)),
+      launch(stream.s, profile),
+      fb(keep ? keep->impl().fb : own),
+      first_use(!keep || !keep->impl().used) {
+  const uint32_t pixels = s.width * s.height;
   if (keep && keep->impl().used) {
     const DeviceFilm::Impl& k = keep->impl();
     if (k.width != film.width() || k.height != film.height() || k.variance != film.has_variance())
@@ -129,23 +153,12 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   }
   if (first_use) fb.allocate(film, pixels);
 
-  if (settings.strategy != Strategy::Pixel && settings.precision != Precision::Float)
-    throw InputError(fmt::format("--precision {}: the GPU runs double precision with --strategy pixel only (its "
-                                 "wavefront state is float4 arrays)", to_string(settings.precision)));
-  if (settings.strategy != Strategy::Pixel && !settings.watertight)
-    throw InputError("--no-watertight: the GPU runs the Moeller-Trumbore triangle test with --strategy pixel only");
-
-  // Strategy resources.
-  std::vector<std::unique_ptr<PathPool>> pools;  // wavefront: wavefront_pools(...) of them; paper-queue: one
-  std::vector<std::unique_ptr<ScopedStream>> pool_streams;  // the wavefront's pools beyond the first
-  DeviceBuffer<PixelCounters> pixel_counters;
-  uint64_t warmup_total = std::min<uint64_t>(total, pixels);
-  if (settings.strategy == Strategy::Pixel) {
+  warmup_total = std::min<uint64_t>(total, pixels);
+  if (s.strategy == Strategy::Pixel) {
     pixel_counters.allocate(1, "counters", "nothing (a few bytes)");
-  } else if (settings.strategy == Strategy::Wavefront) {
-    uint64_t pif = settings.paths_in_flight
-                       ? settings.paths_in_flight
-                       : default_paths_in_flight(PathPool::state_bytes(shadows), fb.bytes() + g.bytes);
+  } else if (s.strategy == Strategy::Wavefront) {
+    uint64_t pif = s.paths_in_flight ? s.paths_in_flight
+                                     : default_paths_in_flight(PathPool::state_bytes(shadows), fb.bytes() + g.bytes);
     pif = std::min<uint64_t>(pif, total);
     pif = std::max<uint64_t>(pif, 1);
     if (pif > 0xFFFFFFFFull) throw InputError("--paths-in-flight: at most 4294967295 paths");
@@ -166,35 +179,47 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
           "--strategy paper-queue: the paper's global queue holds every path of the frame up front: {}x{} pixels x {} "
           "spp = {} tasks x {} bytes = {:.2f} GB, but the GPU ({}) has {:.2f} GB free{}; lower --spp or "
           "--width/--height, or use --strategy wavefront (memory bounded by --paths-in-flight)",
-          settings.width, settings.height, settings.spp, total, per_task, need / 1e9, info.name, free_b / 1e9,
+          s.width, s.height, s.spp, total, per_task, need / 1e9, info.name, free_b / 1e9,
           total > 0xFFFFFFFFull ? " (and more than 2^32 - 1 tasks cannot be indexed)" : ""));
     pools.push_back(std::make_unique<PathPool>(total, shadows, "the paper-queue global task queue",
                                                "--spp or --width/--height"));
     warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
   }
 
-  const PixelOccupancy occupancy = settings.strategy == Strategy::Pixel ? pixel_occupancy(g) : PixelOccupancy{};
-  std::vector<PathPool*> pool_ptrs;
-  std::vector<cudaStream_t> pool_stream_ids{stream.s};  // pool k's stream: the render's, then pool_streams
+  occupancy = s.strategy == Strategy::Pixel ? pixel_occupancy(g) : PixelOccupancy{};
+  pool_stream_ids.push_back(stream.s);
   for (const auto& pool : pools) pool_ptrs.push_back(pool.get());
   for (const auto& ps : pool_streams) pool_stream_ids.push_back(ps->s);
-  auto run_frame = [&](uint64_t n) {
-    if (settings.strategy == Strategy::Pixel)
-      return run_pixel(launch, stream.s, g, config, spp, n, fb.view, film.has_variance(), settings.precision,
-                       settings.watertight, pixel_counters, occupancy.min_blocks);
-    return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, spp, n, fb.view,
-                     film.has_variance());
-  };
+}
 
-  // Warm-up (module load, first-touch of every buffer), then the timed frame. A kept
-  // film's later renders add to what is there: the first one warmed up.
-  if (first_use) {
-    fb.clear(stream.s);
-    run_frame(warmup_total);
-    PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
+FrameResult RenderSetup::run_frame(uint64_t n, bool variance) {
+  if (settings.strategy == Strategy::Pixel)
+    return run_pixel(launch, stream.s, g, config, spp, n, fb.view, variance, settings.precision, settings.watertight,
+                     pixel_counters, occupancy.min_blocks);
+  return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, spp, n, fb.view,
+                   variance);
+}
+
+// 2. The frame: a warm-up (module load, first-touch of every buffer) on the film's first
+// use, then the timed frame between CUDA events, then the film back to the host (not a
+// kept film: its owner downloads it once, after its last render).
+struct TimedFrame {
+  FrameResult result;
+  double seconds = 0;     // host wall clock around the frame
+  float device_ms = 0;    // CUDA events around the frame
+  double download_seconds = 0;
+};
+
+TimedFrame run_timed_frame(RenderSetup& su, Film& film, DeviceFilm* keep) {
+  DeviceMemory& mem = DeviceMemory::instance();
+  // A kept film's later renders add to what is there: the first one warmed up.
+  if (su.first_use) {
+    su.fb.clear(su.stream.s);
+    su.run_frame(su.warmup_total, film.has_variance());
+    PB_CUDA_CHECK(cudaStreamSynchronize(su.stream.s));
     mem.sample();
-    launch.clear();
-    fb.clear(stream.s);
+    su.launch.clear();
+    su.fb.clear(su.stream.s);
   }
   if (keep) {
     DeviceFilm::Impl& k = keep->impl();
@@ -204,21 +229,33 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
     k.variance = film.has_variance();
   }
 
+  TimedFrame t;
   ScopedEvent ev0, ev1;
-  PB_CUDA_CHECK(cudaStreamSynchronize(stream.s));
+  PB_CUDA_CHECK(cudaStreamSynchronize(su.stream.s));
   const auto t0 = std::chrono::steady_clock::now();
-  PB_CUDA_CHECK(cudaEventRecord(ev0.e, stream.s));
-  const FrameResult r = run_frame(total);
-  PB_CUDA_CHECK(cudaEventRecord(ev1.e, stream.s));
+  PB_CUDA_CHECK(cudaEventRecord(ev0.e, su.stream.s));
+  t.result = su.run_frame(su.total, film.has_variance());
+  PB_CUDA_CHECK(cudaEventRecord(ev1.e, su.stream.s));
   PB_CUDA_CHECK(cudaEventSynchronize(ev1.e));
   const auto t1 = std::chrono::steady_clock::now();
   mem.sample();
-  float device_ms = 0;
-  PB_CUDA_CHECK(cudaEventElapsedTime(&device_ms, ev0.e, ev1.e));
+  PB_CUDA_CHECK(cudaEventElapsedTime(&t.device_ms, ev0.e, ev1.e));
+  t.seconds = std::chrono::duration<double>(t1 - t0).count();
 
-  const double download_seconds = keep ? 0.0 : download_film(fb, film);
+  t.download_seconds = keep ? 0.0 : download_film(su.fb, film);
+  return t;
+}
 
-  report.seconds = std::chrono::duration<double>(t1 - t0).count();
+// 3. The report: the frame's counts and times, the device's memory, and report.extra's
+// GPU sections (the device, the BVH, the strategy's pools or occupancy, the profile).
+void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool profile, bool kept, RunReport& report) {
+  const RenderSettings& settings = su.settings;
+  const GpuScene::Impl& g = su.g;
+  const DeviceInfo& info = su.info;
+  const FrameResult& r = t.result;
+  const DeviceMemory& mem = DeviceMemory::instance();
+  const float device_ms = t.device_ms;
+  report.seconds = t.seconds;
   report.device_seconds = double(device_ms) / 1e3;
   report.rays.camera = r.stats.camera;
   report.rays.bounce = r.stats.bounce;
@@ -242,7 +279,7 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
               {"cuda_architectures_built", PATHBENCH_CUDA_ARCHS}};
   x["device_bytes_allocated_peak"] = mem.peak_allocated();
   x["device_bytes_meminfo_delta_peak"] = mem.peak_meminfo_delta();
-  x["film_device_bytes"] = fb.bytes();
+  x["film_device_bytes"] = su.fb.bytes();
   x["scene_device_bytes"] = g.bytes;
   x["bvh"] = {{"layout", to_string(g.layout)}, {"nodes", g.bvh_nodes}, {"node_bytes", g.bvh_node_bytes},
               {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth},
@@ -258,32 +295,41 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
   x["device_rays_per_second"] = device_ms > 0 ? double(report.rays.total()) / (device_ms / 1e3) : 0.0;
   if (const char* commit = std::getenv("PATHBENCH_SOURCE_COMMIT")) x["source_commit"] = commit;
   x["timing"] = "device_seconds: CUDA events around the frame, after a warm-up frame";
-  if (!keep) x["film_download_seconds"] = download_seconds;  // after the timed frame, not in it
+  if (!kept) x["film_download_seconds"] = t.download_seconds;  // after the timed frame, not in it
   if (settings.strategy != Strategy::Pixel) {
     x["state_layout"] = std::string("2 x (o+pdf, d+pixel, beta+depth, L+sample: float4) + hit u32") +
-                        (shadows.records ? " + shadow record (o, d: float4; c.z+target: float2; L of a finished path: float4)" : "") +
-                        (shadows.pairs ? " + a pair's second ray (d: float4; c.yz: float2)" : "");
+                        (su.shadows.records ? " + shadow record (o, d: float4; c.z+target: float2; L of a finished path: float4)" : "") +
+                        (su.shadows.pairs ? " + a pair's second ray (d: float4; c.yz: float2)" : "");
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
     x["counter_rounds"] = r.counter_rounds;  // work_chunks.cuh: the stages' last rounds from a counter
-    x["pools"] = pools.size();  // path_pool.cuh: run_pools, each on a stream of its own
+    x["pools"] = su.pools.size();  // path_pool.cuh: run_pools, each on a stream of its own
   }
   if (settings.strategy == Strategy::PaperQueue) {
     x["bytes_per_task"] = r.state_bytes_per_path;  // the queues are the compacted state buffers themselves
-    x["tasks"] = total;
+    x["tasks"] = su.total;
   }
   if (settings.strategy == Strategy::Pixel) {
-    x["pixel_block"] = launch.block_size("pixel");
+    x["pixel_block"] = su.launch.block_size("pixel");
     if (settings.precision == Precision::Float && settings.watertight)
-      x["pixel_occupancy"] = {{"min_blocks_per_sm", occupancy.min_blocks}, {"why", occupancy.why}};
+      x["pixel_occupancy"] = {{"min_blocks_per_sm", su.occupancy.min_blocks}, {"why", su.occupancy.why}};
   }
   if (profile) {
-    const nlohmann::json prof = launch.collect();
+    const nlohmann::json prof = su.launch.collect();
     x["profile"] = prof;
     std::fputs(Launcher::format_table(prof).c_str(), stdout);
   }
   if (settings.strategy == Strategy::Pixel)
     x["paths_in_flight_note"] = "pixel: one thread per sample, path state in registers";
+}
+
+void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
+                 RunReport& report, bool profile, DeviceFilm* keep) {
+  if (film.width() != settings.width || film.height() != settings.height)
+    throw std::logic_error("film size does not match the settings");
+  RenderSetup setup(scene, gpu_scene, settings, film, profile, keep);
+  const TimedFrame frame = run_timed_frame(setup, film, keep);
+  fill_report(setup, frame, film, profile, keep != nullptr, report);
 }
 }  // namespace
 

@@ -18,6 +18,7 @@
 #include "pathbench/run/ranks_report.h"
 #include "pathbench/run/run_context.h"
 #include "pathbench/run/world.h"
+#include "film_setup.h"
 #include "gpu_reduce.h"
 #include "rank_tracer.h"
 #if PATHBENCH_HAVE_CUDA
@@ -143,11 +144,11 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     // A CPU rank beside GPU ranks traces the GPU's samples, bit for bit (the hybrid's
     // image is then one GPU's, whichever rank took which chunk).
     const bool beside_gpus = std::find(devices.begin(), devices.end(), "gpu") != devices.end();
-    tracer = std::make_unique<RankTracer>(scene, s, options, s.device == Device::Cpu && beside_gpus);
-    const bool variance = s.variance || options.keep_variance || film.has_variance();
-    if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
-      film = Film(s.width, s.height, variance);
-    film.begin(s.spp, scene.max_emission());  // the frame's scale on every rank
+    const bool gpu_samples = s.device == Device::Cpu && beside_gpus;
+    tracer = std::make_unique<RankTracer>(scene, s, options, gpu_samples);
+    // What the rank's tracer runs (the host tracer of the GPU's samples runs every strategy).
+    if (!gpu_samples) validate_for_tracer(s, s.device);
+    prepare_film(scene, s, options, film);  // the frame's scale on every rank
     tracer->warm_up(film);
   });
   Balance balance = options.balance;

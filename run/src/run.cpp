@@ -10,6 +10,7 @@
 #include "pathbench/run/energy.h"
 #include "pathbench/run/film_hash.h"
 #include "pathbench/run/run_context.h"
+#include "film_setup.h"
 #if PATHBENCH_HAVE_CUDA
 #include "pathbench/gpu/render.h"
 #endif
@@ -45,13 +46,8 @@ void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& 
     std::string why;
     if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
   }
-  // A film that keeps variance sums keeps them (the accuracy study asks for them so).
-  const bool variance = s.variance || options.keep_variance || film.has_variance();
-  if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
-    film = Film(s.width, s.height, variance);
-  // Begun for the whole frame's spp: the fixed-point scale every strategy, device and
-  // (later) rank shares.
-  film.begin(s.spp, scene.max_emission());
+  validate_for_tracer(s, s.device);  // what the device's tracer runs, before it builds anything
+  prepare_film(scene, s, options, film);
   report.scene = scene.name;
   report.triangles = scene.triangles.size();
   report.settings = s;
@@ -77,6 +73,13 @@ void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& 
   check_discarded(scene, s, report);
   // The image's checksum beside its speed (the history stores both in one row).
   report.extra["film_hash"] = film_hash(film);
+}
+
+void prepare_film(const Scene& scene, const RenderSettings& s, const RunOptions& options, Film& film) {
+  const bool variance = s.variance || options.keep_variance || film.has_variance();
+  if (film.width() != s.width || film.height() != s.height || film.has_variance() != variance)
+    film = Film(s.width, s.height, variance);
+  film.begin(s.spp, scene.max_emission());
 }
 
 Rendered render(const Scene& scene, const RenderSettings& settings, const RunOptions& options) {

@@ -178,5 +178,51 @@ TEST(BadSettings, RunRenderValidatesOnce) {
   EXPECT_EQ(film.width(), 1u);  // untouched: refused before the film was sized
 }
 
+// What each device's tracer runs: validate_for_tracer, the one place of these checks (they
+// were in cpu/src/render.cpp and gpu/src/render.cu), with the messages they had there.
+TEST(BadSettings, TracerLimitsPaperQueueIsGpuOnly) {
+  RenderSettings s;
+  s.strategy = Strategy::PaperQueue;
+  expect_input_error([&] { validate_for_tracer(s, Device::Cpu); },
+                     {"--strategy paper-queue", "a GPU strategy; the CPU runs pixel or wavefront"});
+  EXPECT_NO_THROW(validate_for_tracer(s, Device::Gpu));
+}
+// The GPU's wavefront state is float4 arrays, traced with the watertight test: double
+// precision and Moeller-Trumbore run there with --strategy pixel only (on the CPU with any).
+TEST(BadSettings, TracerLimitsGpuVariantsWithPixelOnly) {
+  struct Variant {
+    void (*ask)(RenderSettings&);
+    std::vector<std::string> message;
+  };
+  const Variant variants[] = {
+      {[](RenderSettings& s) { s.precision = Precision::Double; },
+       {"--precision double", "the GPU runs double precision with --strategy pixel only"}},
+      {[](RenderSettings& s) { s.watertight = false; },
+       {"--no-watertight", "Moeller-Trumbore triangle test with --strategy pixel only"}}};
+  for (const Variant& v : variants) {
+    RenderSettings s;
+    v.ask(s);
+    for (Strategy st : {Strategy::Wavefront, Strategy::PaperQueue}) {
+      s.strategy = st;
+      expect_input_error([&] { validate_for_tracer(s, Device::Gpu); }, v.message);
+    }
+    s.strategy = Strategy::Wavefront;
+    EXPECT_NO_THROW(validate_for_tracer(s, Device::Cpu));
+    s.strategy = Strategy::Pixel;
+    EXPECT_NO_THROW(validate_for_tracer(s, Device::Gpu));
+  }
+}
+// The run layer applies them before the tracer builds anything or the film is sized.
+TEST(BadSettings, RunRenderRefusesPaperQueueOnCpuBeforeTheFilm) {
+  RenderSettings s;
+  s.strategy = Strategy::PaperQueue;
+  s.width = s.height = 4;
+  const Scene scene = load_scene("paper-cornell");
+  Film film(1, 1, false);
+  RunReport report;
+  expect_input_error([&] { run::render(scene, s, film, report); }, {"--strategy paper-queue", "GPU strategy"});
+  EXPECT_EQ(film.width(), 1u);  // untouched: refused before the film was sized
+}
+
 }  // namespace
 }  // namespace pb

@@ -128,4 +128,11 @@ constexpr bool use_instancing(Instancing asked, size_t instances) {
   return asked != Instancing::Off && instances > 0;
 }
 
+// What the tracer of `tracer` (the device whose kernels trace the samples) can run: the CPU
+// has no paper-queue; the GPU runs double precision and the Moeller-Trumbore test with
+// --strategy pixel only. Throws InputError naming the option. RenderSettings::validate
+// holds the checks every device shares; the run layer calls this once the device is
+// there, before any scene is built or film allocated for it (run.cpp, rank_tracer.cpp).
+void validate_for_tracer(const RenderSettings& s, Device tracer);
+
 }  // namespace pb
