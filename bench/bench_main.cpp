@@ -184,13 +184,11 @@ int run_benchmarks(int argc, char** argv) {
     try {
       preset = pb::bench::preset_suite(suite_cases);
     } catch (const std::exception& e) {
-      fmt::print(stderr, "pathbench-bench: {}
-", e.what());
+      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
       return 2;
     }
   } else {
-    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling, materials, gpu-layouts, loading or suite)
-",
+    fmt::print(stderr, "pathbench-bench: unknown --preset '{}' (expected quick, paper, scaling, materials, gpu-layouts, loading or suite)\n",
                preset);
     return 2;
   }

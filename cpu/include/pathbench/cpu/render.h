@@ -11,8 +11,8 @@ namespace pb::cpu {
 // Traces `scene` with settings.strategy (pixel or wavefront) into `film`, and fills the
 // CPU's fields of `report`. Called by the run layer (pathbench/run/run.h), which has
 // validated the settings, sized and begun the film, and fills the common report fields
-// (scene, settings, peak memory). Throws InputError on settings the CPU tracer cannot
-// run (e.g. the paper-queue strategy).
+// (scene, settings, peak memory). Settings the CPU tracer cannot run (e.g. the
+// paper-queue strategy) are refused before that, by validate_for_tracer (settings.h).
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report);
 // The same with the Embree scene built once by the caller (make_embree_scene with the
 // settings' watertight and layout), for many renders of one scene: an MPI rank's chunks.

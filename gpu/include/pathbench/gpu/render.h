@@ -109,8 +109,9 @@ class DeviceFilm {
 // (pathbench/run/run.h), which has validated the settings, checked the device, sized
 // and begun the film, and fills the common report fields. `profile`
 // prints a per-stage table (name, launches, total ms, share) to stdout and adds it to
-// report.extra["profile"]. Throws InputError for no device, settings the GPU cannot
-// run, or device memory too small for the request (naming the setting to lower).
+// report.extra["profile"]. Throws InputError for no device or device memory too small
+// for the request (naming the setting to lower); settings the GPU cannot run are refused
+// before, by validate_for_tracer (settings.h).
 void render(const Scene& scene, const RenderSettings& settings, Film& film, RunReport& report, bool profile = false);
 void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
             RunReport& report, bool profile = false, DeviceFilm* keep = nullptr);
