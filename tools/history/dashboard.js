@@ -1,5 +1,7 @@
 // pathbench history dashboard: draws every series of the inline JSON (report.py) as SVG.
 // Written by hand, no library: the page must work offline and from file:// (CI's headless chromium).
+// Every name from the data reaches the page as a text node or an attribute value (setAttribute),
+// never as markup; links only from data.commit_url, which report.py checked to be http(s).
 "use strict";
 (function () {
   const data = JSON.parse(document.getElementById("history-data").textContent);
@@ -24,35 +26,42 @@
     return String(Number(v.toPrecision(d)));  // 9050, not 9.05e+3
   }
   function pct(v) { return v === null || v === undefined ? "–" : (v >= 0 ? "+" : "") + (100 * v).toFixed(2) + "%"; }
+  const COMMIT_URL = /^https?:\/\//i.test(data.commit_url || "") ? data.commit_url : "";
   function commitNode(sha, parent) {
     const short = sha.slice(0, 10);
-    if (window.COMMIT_URL) return text(el("a", { href: window.COMMIT_URL.replace("{}", sha) }, parent), short);
+    if (COMMIT_URL) return text(el("a", { href: COMMIT_URL.split("{}").join(encodeURIComponent(sha)) }, parent), short);
     return text(el("code", { title: sha }, parent), short);
   }
   function median(xs) {
     const s = xs.slice().sort((a, b) => a - b), n = s.length;
-    return n % 2 ? s[(n - 1) / 2] : (s[n / 2 - 1] + s[n / 2]) / 2;
+    return n % 2 ? s[(n - 1) / 2] : s[n / 2 - 1] / 2 + s[n / 2] / 2;  // halves: no overflow
   }
 
   // One chart: x = runs in commit order, y = each repetition (dots) and the run's median (line).
   function chart(series, metric, parent) {
     const pts = series.points.map((p) => (metric === "rays" ? p.rays : p.values));
     const meds = pts.map((v) => (v.length ? median(v) : null));
-    const all = pts.flat();
-    let lo = Math.min(...all), hi = Math.max(...all);
-    if (lo === hi) { lo -= Math.abs(lo) * 0.01 || 1; hi += Math.abs(hi) * 0.01 || 1; }
-    const pad = (hi - lo) * 0.08; lo -= pad; hi += pad;
+    // A loop, not Math.min(...all): a long series would overflow the argument list.
+    let lo = Infinity, hi = -Infinity;
+    for (const v of pts) for (const w of v) { if (w < lo) lo = w; if (w > hi) hi = w; }
+    if (!(lo <= hi)) { lo = 0; hi = 1; }
+    // Worked in units of the largest magnitude, so values near the double range cannot overflow.
+    const scale = Math.max(Math.abs(lo), Math.abs(hi)) || 1;
+    let nlo = lo / scale, nhi = hi / scale;
+    if (nlo === nhi) { nlo -= Math.abs(nlo) * 0.01 || 1; nhi += Math.abs(nhi) * 0.01 || 1; }
+    const pad = (nhi - nlo) * 0.08; nlo -= pad; nhi += pad;
+    lo = nlo * scale; hi = nhi * scale;
     const n = pts.length;
     const x = (i) => M.l + (n === 1 ? 0.5 : i / (n - 1)) * (W - M.l - M.r);
-    const y = (v) => M.t + (1 - (v - lo) / (hi - lo)) * (H - M.t - M.b);
+    const y = (v) => M.t + (1 - (v / scale - nlo) / (nhi - nlo)) * (H - M.t - M.b);
     const s = svg("svg", { width: W, height: H, viewBox: `0 0 ${W} ${H}`, class: "chart", "data-metric": metric });
     parent.appendChild(s);
     svg("line", { x1: M.l, y1: M.t, x2: M.l, y2: H - M.b, class: "axis" }, s);
     svg("line", { x1: M.l, y1: H - M.b, x2: W - M.r, y2: H - M.b, class: "axis" }, s);
     for (let k = 0; k <= 4; k++) {
-      const v = lo + (k / 4) * (hi - lo);
+      const v = (nlo + (k / 4) * (nhi - nlo)) * scale;
       svg("line", { x1: M.l, x2: W - M.r, y1: y(v), y2: y(v), class: "grid" }, s);
-      const digits = Math.min(8, Math.max(3, Math.ceil(Math.log10(Math.abs(hi) / (hi - lo))) + 2));
+      const digits = Math.min(8, Math.max(3, Math.ceil(Math.log10(Math.abs(nhi) / (nhi - nlo))) + 2));
       text(svg("text", { x: M.l - 4, y: y(v) + 3, class: "ytick" }, s), fmt(v, digits));
     }
     const unit = metric === "rays" ? "rays/s" : series.unit;
@@ -106,6 +115,38 @@
     }
   }
 
+  function panel(s, parent, id) {
+    const p = el("div", { class: "panel", id: id }, parent);
+    const cap = el("p", { class: "caption" }, p);
+    text(el("b", {}, cap), `${s.device ? s.device.toUpperCase() + " · " : ""}${s.machine} ${s.machine_id.slice(0, 6)}`);
+    text(cap, `${s.preset ? " · preset " + s.preset : ""} · ${s.points.length} runs · latest ${fmt(s.latest)} ` +
+      `${s.unit} (${pct(s.latest_vs_baseline)} vs first)`);
+    for (const c of s.changes) {
+      text(cap, ` · change ${pct(c.change)} ${c.p_value === null ? "(exact)" : "p=" + c.p_value.toExponential(1)} at `);
+      commitNode(c.commit, cap);
+    }
+    return p;
+  }
+
+  // The first screen: the paper frame and the suite per machine and device over commits.
+  function headline() {
+    const root = document.getElementById("headline");
+    const chosen = data.series.filter((s) => s.headline);
+    if (!chosen.length) return;
+    const labels = [...new Set(chosen.map((s) => s.headline))];
+    for (const label of labels) {
+      const list = chosen.filter((s) => s.headline === label);
+      list.sort((a, b) => (a.machine + a.device + a.benchmark < b.machine + b.device + b.benchmark ? -1 : 1));
+      text(el("h2", {}, root), label);
+      const row = el("div", { class: "row headline" }, root);
+      for (const s of list) {
+        const p = panel(s, row, "h-" + s.id);
+        text(el("p", { class: "caption name" }, p), s.benchmark);
+        chart(s, "time", p);
+      }
+    }
+  }
+
   // One row per benchmark: its series on every machine side by side, CPU before GPU, so a CPU and
   // a GPU run of the same render (or two machines) can be read against each other.
   function plots() {
@@ -118,25 +159,19 @@
     for (const [group, list] of groups) {
       const row = el("div", { class: "row" }, root);
       const devices = [...new Set(list.map((s) => s.device).filter(Boolean))].join(" | ");
-      text(el("h3", {}, row), group.replace("{device}", devices.includes("|") ? "[" + devices + "]" : devices || "-"));
+      text(el("h3", {}, row), group.split("{device}").join(devices.includes("|") ? "[" + devices + "]" : devices || "-"));
       list.sort((a, b) => (a.device + a.machine + a.preset < b.device + b.machine + b.preset ? -1 : 1));
       for (const s of list) {
-        const panel = el("div", { class: "panel", id: s.id }, row);
-        const cap = el("p", { class: "caption" }, panel);
-        text(el("b", {}, cap), `${s.device ? s.device.toUpperCase() + " · " : ""}${s.machine} ${s.machine_id.slice(0, 6)}`);
-        text(cap, `${s.preset ? " · preset " + s.preset : ""} · ${s.points.length} runs · latest ${fmt(s.latest)} ` +
-          `${s.unit} (${pct(s.latest_vs_baseline)} vs first)`);
-        for (const c of s.changes) {
-          text(cap, ` · change ${pct(c.change)} ${c.p_value === null ? "(exact)" : "p=" + c.p_value.toExponential(1)} at `);
-          commitNode(c.commit, cap);
-        }
-        chart(s, "time", panel);
-        if (s.points.some((p) => p.rays.length)) chart(s, "rays", panel);
+        const p = panel(s, row, s.id);
+        chart(s, "time", p);
+        if (s.points.some((q) => q.rays.length)) chart(s, "rays", p);
       }
     }
   }
 
+  headline();
   summary();
   plots();
-  document.body.setAttribute("data-drawn", String(document.querySelectorAll("svg.chart").length));
+  document.body.setAttribute("data-headline", String(document.querySelectorAll("#headline svg.chart").length));
+  document.body.setAttribute("data-drawn", String(document.querySelectorAll("#plots svg.chart").length));
 })();
