@@ -75,6 +75,8 @@ def rebuild(folder: str, db_path: str) -> int:
     from . import importer
     if os.path.isdir(db_path):
         raise store.UserError(f"{db_path}: is a folder, not a history database")
+    if os.path.exists(db_path):  # replaced only if it is one: never a file that holds something else
+        store.connect(db_path, create=False, readonly=True).close()
     files = sorted(glob.glob(os.path.join(glob.escape(folder), "*.jsonl")))
     runs, seen = [], {}
     for path in files:

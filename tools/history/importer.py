@@ -214,7 +214,8 @@ def _bench_results(path: str, rows) -> list[dict]:
             counters["threads"] = real(row["threads"], f"{where}.threads")
         out.append({"benchmark": text(row.get("run_name", name), f"{where}.run_name"),
                     "repetition": integer(row.get("repetition_index", 0), f"{where}.repetition_index", hi=2**31 - 1),
-                    "value": real(row["real_time"], f"{where}.real_time"),
+                    "value": _non_negative(real(row["real_time"], f"{where}.real_time", optional=False),
+                                           f"{where}.real_time"),
                     "unit": text(row["time_unit"], f"{where}.time_unit", limit=64),
                     "cpu_time": real(row.get("cpu_time"), f"{where}.cpu_time"),
                     "iterations": integer(row.get("iterations"), f"{where}.iterations", optional=True),
