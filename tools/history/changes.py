@@ -96,11 +96,11 @@ def series(db, benchmark: str | None = None, machine: str | None = None) -> dict
 
 def detect(values: list[float], max_pvalue: float = DEFAULT_MAX_PVALUE, min_change: float = DEFAULT_MIN_CHANGE):
     """[(index of the first point after the change, relative change, p)] by Otava."""
-    from otava.analysis import compute_change_points  # imported late: `record` works without it
     if len(values) < 3:
         return []
     if max(values) == min(values):
         return []  # a flat series (instruction counts of unchanged code): Otava's t-test would give NaN
+    from otava.analysis import compute_change_points  # imported late: `record` works without it
     # Relative changes and the t-test do not depend on the unit: scaled to the largest value, a
     # series of huge numbers cannot overflow inside Otava.
     scale = max(abs(v) for v in values) or 1.0
