@@ -550,3 +550,35 @@ def test_dashboard_first_screen_is_the_headline_plots_with_the_table_collapsed(t
     assert "open" not in details
     headline = dom[dom.index('id="headline"'):dom.index('id="summary-box"')]
     assert headline.count('class="cp slower"') == 3 and "raycast/cpu/other" not in headline
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (scripts/install-deps.sh installs it)")
+def test_values_near_the_double_range_draw_in_the_png_and_the_page(tmp_path):
+    """1.7e308 and 5e-324 side by side: no overflow in the medians, the PNG or the SVG axes."""
+    vals = [1.7e308, 1e308, 1.7e308, 5e-324, 0.0, 1.7e308, 1e-300, 1.7e308]
+    paths = []
+    for i, v in enumerate(vals):
+        data = {"context": {"host_name": "h", "cpu_model": "c", "num_cpus": 2, "git_revision": f"{i:040x}",
+                            "date": f"2026-01-01T00:{i:02d}:00Z", "commit_date": f"2026-01-01T00:{i:02d}:00Z"},
+                "benchmarks": [{"name": n, "run_type": "iteration", "repetition_index": r, "real_time": v / (1 + r),
+                                "time_unit": u, "iterations": 1, "rays_per_second": 1e308}
+                               for n, u in (("a/x", "ms"), ("b/instr", "instructions")) for r in range(2)]}
+        paths.append(tmp_path / f"r{i}.json")
+        paths[-1].write_text(json.dumps(data))
+    db = tmp_path / "h.sqlite"
+    hist("record", "--db", db, "--export", "", *paths, check=0)
+    hist("changes", "--db", db, "--json", check=0)
+    site = tmp_path / "site"
+    hist("report", "--db", db, "--out", site, check=0)
+    assert len(list((site / "png").glob("*.png"))) == 2
+    dom, console = _dom(tmp_path, site)
+    assert console == [] and 'data-drawn="4"' in dom and "NaN" not in dom and "Infinity" not in dom
+
+
+def test_backfill_range_is_never_an_option(tmp_path):
+    target = tmp_path / "created-by-git"
+    for rng in (f"--output={target}", f"HEAD --output={target}"):
+        r = hist("backfill", "--repo", ROOT, "--scratch", tmp_path / "s", "--json-dir", tmp_path / "j", "--", rng)
+        assert r.returncode == 2 and "not a revision range" in r.stderr and r.stderr.count("\n") == 1, r.stderr
+    assert not list(tmp_path.glob("created-by-git*"))
+    one_line_error(hist("backfill", "--wall", "many"))

@@ -59,10 +59,14 @@ def build(scratch: str, build_dir: str, log) -> bool:
 
 def run(repo: str, rev_range: str, scratch: str, json_dir: str, db: str | None, wall: int,
         machine: str | None, log_path: str | None, export_dir: str | None = None) -> int:
+    if not rev_range or rev_range.startswith("-") or any(c.isspace() or ord(c) < 32 for c in rev_range):
+        print(f"backfill: {rev_range[:80]!r}: not a revision range", file=sys.stderr)
+        return 2
     try:
-        revs = _git(repo, "rev-list", "--reverse", "--first-parent", rev_range).split()
+        revs = _git(repo, "rev-list", "--reverse", "--first-parent", "--end-of-options", rev_range).split()
     except subprocess.CalledProcessError as e:
-        print(f"backfill: {rev_range}: not a revision range in {repo}: {e.stderr.strip()}", file=sys.stderr)
+        detail = " ".join(e.stderr.split())[:200]
+        print(f"backfill: {rev_range!r}: not a revision range in {repo}: {detail}", file=sys.stderr)
         return 2
     if not revs:
         print(f"backfill: {rev_range}: no commits in this range", file=sys.stderr)
@@ -155,7 +159,8 @@ def import_git(repo: str, paths: list[str], db: str, export_dir: str | None, mac
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pathbench history backfill", description=__doc__.split("\n\n")[0])
+    from .cli import _Parser  # usage errors as one line, exit 2
+    ap = _Parser(prog="pathbench history backfill", description=__doc__.split("\n\n")[0])
     ap.add_argument("range", nargs="?", help="git revision range, e.g. HEAD~45..HEAD")
     ap.add_argument("--git-results", nargs="+", metavar="JSON",
                     help="instead of building: record every committed version of these bench JSON files (needs --db)")

@@ -53,16 +53,17 @@
     lo = nlo * scale; hi = nhi * scale;
     const n = pts.length;
     const x = (i) => M.l + (n === 1 ? 0.5 : i / (n - 1)) * (W - M.l - M.r);
-    const y = (v) => M.t + (1 - (v / scale - nlo) / (nhi - nlo)) * (H - M.t - M.b);
+    const yn = (nv) => M.t + (1 - (nv - nlo) / (nhi - nlo)) * (H - M.t - M.b);  // nv: in units of scale
+    const y = (v) => yn(v / scale);
     const s = svg("svg", { width: W, height: H, viewBox: `0 0 ${W} ${H}`, class: "chart", "data-metric": metric });
     parent.appendChild(s);
     svg("line", { x1: M.l, y1: M.t, x2: M.l, y2: H - M.b, class: "axis" }, s);
     svg("line", { x1: M.l, y1: H - M.b, x2: W - M.r, y2: H - M.b, class: "axis" }, s);
     for (let k = 0; k <= 4; k++) {
-      const v = (nlo + (k / 4) * (nhi - nlo)) * scale;
-      svg("line", { x1: M.l, x2: W - M.r, y1: y(v), y2: y(v), class: "grid" }, s);
+      const nv = nlo + (k / 4) * (nhi - nlo), v = nv * scale;  // v: Infinity past the double range
+      svg("line", { x1: M.l, x2: W - M.r, y1: yn(nv), y2: yn(nv), class: "grid" }, s);
       const digits = Math.min(8, Math.max(3, Math.ceil(Math.log10(Math.abs(nhi) / (nhi - nlo))) + 2));
-      text(svg("text", { x: M.l - 4, y: y(v) + 3, class: "ytick" }, s), fmt(v, digits));
+      text(svg("text", { x: M.l - 4, y: yn(nv) + 3, class: "ytick" }, s), Number.isFinite(v) ? fmt(v, digits) : "");
     }
     const unit = metric === "rays" ? "rays/s" : series.unit;
     text(svg("text", { x: 12, y: M.t + (H - M.t - M.b) / 2, class: "ylabel",

@@ -137,10 +137,16 @@ def _png(series: dict, path: str) -> None:
 def _png_plot(series: dict, path: str) -> None:
     import matplotlib.pyplot as plt
     pts = series["points"]
+    # Drawn in a power of ten of the unit where values are extreme: matplotlib's transforms
+    # overflow near the double range (and lose the axis below 1e-300).
+    top = max((abs(v) for p in pts for v in p["values"]), default=0.0)
+    exp = math.floor(math.log10(top)) if top and not 1e-6 <= top <= 1e12 else 0
+    k = 10.0 ** -exp if -300 < exp < 300 else None
+    scaled = (lambda v: v * k) if k else (lambda v: v / 10.0 ** (exp // 2) / 10.0 ** (exp - exp // 2))
     fig, ax = plt.subplots(figsize=(9, 3.2), dpi=100)
     for i, p in enumerate(pts):
-        ax.plot([i] * len(p["values"]), p["values"], ".", color="#9bb7d4", ms=4)
-    ax.plot(range(len(pts)), [p["median"] for p in pts], "-", color="#1f4e79", lw=1.5)
+        ax.plot([i] * len(p["values"]), [scaled(v) for v in p["values"]], ".", color="#9bb7d4", ms=4)
+    ax.plot(range(len(pts)), [scaled(p["median"]) for p in pts], "-", color="#1f4e79", lw=1.5)
     for c in series["changes"]:
         ax.axvline(c["index"] - 0.5, color="#c0392b" if c["change"] > 0 else "#1e8449", ls="--", lw=1)
         ax.annotate(f"{c['commit'][:7]} {c['change'] * 100:+.1f}%", (c["index"] - 0.4, ax.get_ylim()[1]),
@@ -148,7 +154,7 @@ def _png_plot(series: dict, path: str) -> None:
     step = max(1, len(pts) // 20)
     ax.set_xticks(range(0, len(pts), step), [pts[i]["commit"][:7] for i in range(0, len(pts), step)],
                   rotation=60, fontsize=7)
-    ax.set_ylabel(series["unit"])
+    ax.set_ylabel(series["unit"] + (f" x 1e{exp}" if exp else ""))
     ax.set_title(f"{series['benchmark']}  [{series['machine']} {series['machine_id'][:6]}, {series['preset']}]",
                  fontsize=9)
     fig.tight_layout()
