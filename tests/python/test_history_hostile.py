@@ -582,3 +582,13 @@ def test_backfill_range_is_never_an_option(tmp_path):
         assert r.returncode == 2 and "not a revision range" in r.stderr and r.stderr.count("\n") == 1, r.stderr
     assert not list(tmp_path.glob("created-by-git*"))
     one_line_error(hist("backfill", "--wall", "many"))
+
+
+def test_a_database_edited_to_hold_text_for_a_value_is_exit_2(tmp_path):
+    db = record_db(tmp_path)
+    con = sqlite3.connect(db)
+    con.execute("UPDATE results SET value='fast' WHERE rowid=1")
+    con.commit()
+    con.close()
+    assert "not a number" in one_line_error(hist("changes", "--db", db))
+    assert "not a number" in one_line_error(hist("report", "--db", db, "--out", tmp_path / "site", "--no-png"))

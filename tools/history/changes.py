@@ -84,6 +84,11 @@ def series(db, benchmark: str | None = None, machine: str | None = None) -> dict
     pattern = re.compile(benchmark) if benchmark else None
     out: dict[tuple[str, str], list[Point]] = {}
     for bench, mid, preset, rid, commit, date, value in rows:
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or not isinstance(bench, str):
+            # Only a database edited by hand (or damaged) holds these: record never writes them.
+            raise store.UserError(f"the database holds a value that is not a number (run {rid}, {str(bench)[:80]}): "
+                                  "rebuild it from the run files")
+        commit, date, preset = str(commit), str(date), str(preset)
         if pattern and not pattern.search(bench):
             continue
         pts = out.setdefault((bench, mid, preset), [])
@@ -118,7 +123,7 @@ def exact_steps(values: list[float], min_change: float = DEFAULT_MIN_CHANGE):
 
 def find(db, benchmark=None, machine=None, max_pvalue=DEFAULT_MAX_PVALUE, min_change=DEFAULT_MIN_CHANGE,
          exact: bool = True) -> list[Change]:
-    names = dict(db.execute("SELECT id, name FROM machines").fetchall())
+    names = {k: str(v) for k, v in db.execute("SELECT id, name FROM machines").fetchall()}
     units = dict(db.execute("SELECT benchmark, MAX(unit) FROM results GROUP BY benchmark").fetchall())
     found = []
     for (bench, mid, preset), pts in sorted(series(db, benchmark, machine).items()):
