@@ -6,7 +6,8 @@
 (function () {
   const data = JSON.parse(document.getElementById("history-data").textContent);
   const NS = "http://www.w3.org/2000/svg";
-  const W = 560, H = 230, M = { l: 64, r: 36, t: 14, b: 58 };
+  const M = { l: 64, r: 36, t: 14, b: 58 };
+  let W = 560, H = 230;  // a chart's size; the headline's are smaller, three to a row
 
   function el(tag, attrs, parent, ns) {
     const e = ns ? document.createElementNS(NS, tag) : document.createElement(tag);
@@ -38,7 +39,8 @@
   }
 
   // One chart: x = runs in commit order, y = each repetition (dots) and the run's median (line).
-  function chart(series, metric, parent) {
+  function chart(series, metric, parent, size) {
+    [W, H] = size || [560, 230];
     const pts = series.points.map((p) => (metric === "rays" ? p.rays : p.values));
     const meds = pts.map((v) => (v.length ? median(v) : null));
     // A loop, not Math.min(...all): a long series would overflow the argument list.
@@ -143,7 +145,7 @@
       for (const s of list) {
         const p = panel(s, row, "h-" + s.id);
         text(el("p", { class: "caption name" }, p), s.benchmark);
-        chart(s, "time", p);
+        chart(s, "time", p, [440, 200]);
       }
     }
   }
