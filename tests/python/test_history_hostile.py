@@ -269,9 +269,9 @@ def test_extremes_that_are_no_measurement_are_stored_as_null(tmp_path):
 def test_a_huge_file_is_refused_with_the_limit_named(tmp_path):
     p = tmp_path / "huge.json"
     with open(p, "wb") as f:
-        f.truncate((64 << 20) + 1)  # sparse: no disk used
+        f.truncate((32 << 20) + 1)  # sparse: no disk used
     msg = one_line_error(hist("record", "--db", tmp_path / "h.sqlite", p))
-    assert "larger than 64 MiB" in msg
+    assert "larger than 32 MiB" in msg
 
 
 def test_render_report_with_a_list_for_a_name_or_a_huge_size(tmp_path):
