@@ -592,3 +592,14 @@ def test_a_database_edited_to_hold_text_for_a_value_is_exit_2(tmp_path):
     con.close()
     assert "not a number" in one_line_error(hist("changes", "--db", db))
     assert "not a number" in one_line_error(hist("report", "--db", db, "--out", tmp_path / "site", "--no-png"))
+
+
+def test_a_fifo_or_device_is_not_read_and_an_empty_path_is_a_usage_error(tmp_path):
+    fifo = tmp_path / "fifo.json"
+    os.mkfifo(fifo)
+    assert "not a regular file" in one_line_error(hist("record", "--db", tmp_path / "h.sqlite", fifo, timeout=30))
+    assert "not a regular file" in one_line_error(hist("record", "--db", tmp_path / "h.sqlite", "/dev/zero",
+                                                       timeout=30))
+    for args in (["record", "--db", "", QUICK], ["changes", "--db", ":memory:"], ["report", "--out", ""]):
+        assert "give a path" in one_line_error(hist(*args, cwd=tmp_path))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo.json"]

@@ -215,6 +215,9 @@ def _dispatch(argv) -> int:
         return instructions.main(rest)
     if rest:
         raise UsageError(f"unrecognised arguments: {' '.join(rest)}")
+    for opt in ("db", "out", "runs"):  # '' would be the current folder, or for sqlite a throw-away database
+        if getattr(args, opt, None) in ("", ":memory:"):
+            raise UsageError(f"--{opt}: give a path")
     if args.cmd == "record":
         # The text export lives beside its database: results/history/{history.sqlite,runs/} by default.
         if args.export is None:

@@ -15,6 +15,7 @@ import json
 import math
 import os
 import re
+import stat
 import subprocess
 
 from . import export, store
@@ -87,6 +88,8 @@ def loads(text, where: str):
 
 def read_bytes(path: str, limit: int = MAX_FILE_BYTES) -> bytes:
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block, a device never end
+            raise RecordError(f"{path}: not a regular file")
         with open(path, "rb") as f:
             raw = f.read(limit + 1)
     except OSError as e:
