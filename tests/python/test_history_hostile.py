@@ -111,13 +111,17 @@ def _under_a_file(tmp_path):
     return tmp_path / "afile" / "h.sqlite"
 
 
-def _newer_schema(tmp_path):
+def edited_db(tmp_path, sql):
     db = record_db(tmp_path)
     con = sqlite3.connect(db)
-    con.execute("UPDATE meta SET value='99' WHERE key='schema_version'")
+    con.execute(sql)
     con.commit()
     con.close()
     return db
+
+
+def _newer_schema(tmp_path):
+    return edited_db(tmp_path, "UPDATE meta SET value='99' WHERE key='schema_version'")
 
 
 BAD_DBS = [_corrupt, _truncated, _foreign, _text_file, _folder, _under_a_file, _newer_schema]
@@ -585,11 +589,7 @@ def test_backfill_range_is_never_an_option(tmp_path):
 
 
 def test_a_database_edited_to_hold_text_for_a_value_is_exit_2(tmp_path):
-    db = record_db(tmp_path)
-    con = sqlite3.connect(db)
-    con.execute("UPDATE results SET value='fast' WHERE rowid=1")
-    con.commit()
-    con.close()
+    db = edited_db(tmp_path, "UPDATE results SET value='fast' WHERE rowid=1")
     assert "not a number" in one_line_error(hist("changes", "--db", db))
     assert "not a number" in one_line_error(hist("report", "--db", db, "--out", tmp_path / "site", "--no-png"))
 
