@@ -241,7 +241,11 @@ def _on_signal(signum, frame):
 
 def main(argv: list[str] | None = None) -> int:
     """Runs one subcommand and maps every way it can end to the exit status contract (module doc)."""
+    import warnings
     from . import store
+    # numpy/Otava/matplotlib RuntimeWarnings on degenerate series (a division by zero whose result
+    # is filtered out) are no message for the user: stderr holds our one line or nothing.
+    warnings.simplefilter("ignore", RuntimeWarning)
     for stream in (sys.stdout, sys.stderr):
         try:  # a name in a foreign script on an ASCII terminal: escaped, not UnicodeEncodeError
             stream.reconfigure(errors="backslashreplace")

@@ -71,6 +71,13 @@ def one_input(data: bytes) -> None:
         db = store.connect(":memory:")
         try:
             importer.insert_all(db, [run], export_dir=os.path.join(TMP, "runs"))
+            # Two more runs of the same series (other commits, values scaled by data's last byte),
+            # so change points are computed on three points: Otava and the exact steps run too.
+            factor = 1 + (data[-1] if data else 0) / 64
+            for k, f in enumerate((factor, 1 / factor)):
+                more = dict(run, run_key=f"{k + 1:064x}", commit=f"{k + 1:040x}", run_date=f"9999-12-3{k}T00:00:00+00:00",
+                            commit_date=None, results=[dict(r, value=_times(r["value"], f)) for r in run["results"]])
+                importer.insert_all(db, [more])
             # The run file reads back as the same run, and rebuilds to the same rows.
             written = os.path.join(TMP, "runs", export.file_name(run))
             back = export.read_run(written)
@@ -98,6 +105,14 @@ def one_input(data: bytes) -> None:
             db.close()
     except store.UserError:
         pass  # a clean refusal: exit 2 with one line
+
+
+def _times(v, f):
+    """v * f as the history could hold it (finite), else None."""
+    if v is None:
+        return None
+    w = v * f
+    return w if w == w and abs(w) != float("inf") else None
 
 
 def _key(r):
