@@ -603,3 +603,19 @@ def test_a_fifo_or_device_is_not_read_and_an_empty_path_is_a_usage_error(tmp_pat
     for args in (["record", "--db", "", QUICK], ["changes", "--db", ":memory:"], ["report", "--out", ""]):
         assert "give a path" in one_line_error(hist(*args, cwd=tmp_path))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo.json"]
+
+
+def test_a_lock_held_past_the_busy_timeout_is_exit_2_and_leaves_nothing(tmp_path):
+    db, ex = record_db(tmp_path), tmp_path / "runs"
+    holder = sqlite3.connect(db, isolation_level=None)
+    holder.execute("BEGIN EXCLUSIVE")
+    try:
+        env = os.environ | {"PYTHONPATH": TOOLS, "PATHBENCH_HISTORY_BUSY_TIMEOUT": "1"}
+        r = subprocess.run([sys.executable, "-m", "history", "record", "--db", str(db), "--export", str(ex),
+                            str(bench(tmp_path / "b.json", git_revision="1" * 40))], capture_output=True, text=True,
+                           env=env, timeout=60)
+    finally:
+        holder.execute("ROLLBACK")
+        holder.close()
+    assert "database is locked" in one_line_error(r)
+    assert count(db) == 1 and (not ex.exists() or list(ex.iterdir()) == []) and leftovers(tmp_path) == []

@@ -417,37 +417,40 @@ def recorded(db, run_key: str) -> bool:
 def insert_all(db, runs: list[dict], export_dir: str | None = None, skip_recorded: bool = False) -> list[dict]:
     """Stores runs in ONE transaction (BEGIN IMMEDIATE: a concurrent writer waits up to the busy
     timeout, then this one goes; nothing is lost) and, with export_dir, their run files: written
-    to temporary names first, put in place just before the commit, removed again if it fails. All
-    or nothing: a refused run (already recorded) stores none. Returns the runs stored."""
+    to temporary names first (before the lock is taken, so it is held only for the inserts), put in
+    place just before the commit, removed again if it fails. All or nothing: a refused run (already
+    recorded) stores none. Returns the runs stored."""
     from . import export
-    staged: list[tuple[str, str]] = []  # (temporary file, final name)
+    staged: dict[str, tuple[str, str]] = {}  # run_key -> (temporary file, final name)
     placed: list[str] = []
     stored = []
-    db.execute("BEGIN IMMEDIATE")
     try:
-        for run in runs:
-            if skip_recorded and recorded(db, run["run_key"]):
-                continue
-            _insert_rows(db, run)
-            stored.append(run)
         if export_dir:
-            for run in stored:
-                staged.append(export.stage_run(export_dir, run))
-            for tmp, final in staged:
-                existed = os.path.exists(final)
-                os.replace(tmp, final)
-                if not existed:
-                    placed.append(final)
-        db.execute("COMMIT")
-    except BaseException:
+            for run in runs:
+                staged[run["run_key"]] = export.stage_run(export_dir, run)
+        db.execute("BEGIN IMMEDIATE")
         try:
+            for run in runs:
+                if skip_recorded and recorded(db, run["run_key"]):
+                    continue
+                _insert_rows(db, run)
+                stored.append(run)
+            for run in stored:
+                if run["run_key"] in staged:
+                    tmp, final = staged.pop(run["run_key"])
+                    existed = os.path.exists(final)
+                    os.replace(tmp, final)
+                    if not existed:
+                        placed.append(final)
+            db.execute("COMMIT")
+        except BaseException:
             db.execute("ROLLBACK")
-        finally:
-            for tmp, _ in staged:
-                _remove(tmp)
             for final in placed:
                 _remove(final)
-        raise
+            raise
+    finally:
+        for tmp, _ in staged.values():  # runs skipped, or everything after a failure
+            _remove(tmp)
     return stored
 
 

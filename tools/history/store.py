@@ -15,10 +15,19 @@ import pathlib
 import sqlite3
 
 SCHEMA_VERSION = 1
-# How long a writer waits for another one to finish (sqlite's busy timeout, seconds). A large run
-# (tens of thousands of rows) commits in well under a second; ten writers queue for a few seconds.
-# Generous, so that concurrent `history record` runs never lose one to "database is locked".
-BUSY_TIMEOUT_S = float(os.environ.get("PATHBENCH_HISTORY_BUSY_TIMEOUT", "600"))
+# How long a writer waits for another one to finish (sqlite's busy timeout, seconds). The largest
+# run a file may hold (32 MiB, ~165,000 rows) holds the lock ~4 s on the loaded 2-core VM; a
+# 4,000-row run well under one. 120 s lets ten writers of the largest runs queue with room to
+# spare, and still ends (exit 2, "database is locked") where a writer hangs holding the lock.
+def _busy_timeout(default: float = 120.0) -> float:
+    try:
+        v = float(os.environ.get("PATHBENCH_HISTORY_BUSY_TIMEOUT", default))
+    except ValueError:
+        return default
+    return v if 0 <= v <= 86400 else default
+
+
+BUSY_TIMEOUT_S = _busy_timeout()
 
 SCHEMA = """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
