@@ -60,16 +60,17 @@ def build(scratch: str, build_dir: str, log) -> bool:
 def run(repo: str, rev_range: str, scratch: str, json_dir: str, db: str | None, wall: int,
         machine: str | None, log_path: str | None, export_dir: str | None = None) -> int:
     if not rev_range or rev_range.startswith("-") or any(c.isspace() or ord(c) < 32 for c in rev_range):
-        print(f"backfill: {rev_range[:80]!r}: not a revision range", file=sys.stderr)
+        print(f"pathbench history backfill: error: {rev_range[:80]!r}: not a revision range", file=sys.stderr)
         return 2
     try:
         revs = _git(repo, "rev-list", "--reverse", "--first-parent", "--end-of-options", rev_range).split()
     except subprocess.CalledProcessError as e:
         detail = " ".join(e.stderr.split())[:200]
-        print(f"backfill: {rev_range!r}: not a revision range in {repo}: {detail}", file=sys.stderr)
+        print(f"pathbench history backfill: error: {rev_range[:80]!r}: not a revision range in {repo}: {detail}",
+              file=sys.stderr)
         return 2
     if not revs:
-        print(f"backfill: {rev_range}: no commits in this range", file=sys.stderr)
+        print(f"pathbench history backfill: error: {rev_range[:80]!r}: no commits in this range", file=sys.stderr)
         return 2
     os.makedirs(json_dir, exist_ok=True)
     if not os.path.isdir(os.path.join(scratch, ".git")):
@@ -175,12 +176,17 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.git_results:
         if not a.db:
-            print("backfill: --git-results needs --db", file=sys.stderr)
+            print("pathbench history backfill: error: --git-results needs --db", file=sys.stderr)
             return 2
-        import_git(os.path.abspath(a.repo), a.git_results, a.db, a.export, a.machine)
+        try:
+            import_git(os.path.abspath(a.repo), a.git_results, a.db, a.export, a.machine)
+        except subprocess.CalledProcessError as e:  # not a repository, a path outside it
+            from .store import UserError
+            detail = " ".join((e.stderr or "").split())[:200] if isinstance(e.stderr, str) else ""
+            raise UserError(f"{a.repo}: git {' '.join(e.cmd[3:5])} failed: {detail}") from None
         return 0
     if not a.range:
-        print("backfill: give a revision range (or --git-results)", file=sys.stderr)
+        print("pathbench history backfill: error: give a revision range (or --git-results)", file=sys.stderr)
         return 2
     return run(os.path.abspath(a.repo), a.range, os.path.abspath(a.scratch), os.path.abspath(a.json_dir),
                a.db, a.wall, a.machine, a.log, a.export)

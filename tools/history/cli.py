@@ -137,14 +137,14 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(f"{message} (see `{self.prog} --help`)")
 
 
-def _probability(text: str) -> float:
+def probability(text: str) -> float:
     v = float(text)
     if not 0 < v <= 1:
         raise ValueError(text)
     return v
 
 
-def _fraction(text: str) -> float:
+def fraction(text: str) -> float:
     v = float(text)
     if not 0 <= v < 1e6:
         raise ValueError(text)
@@ -183,8 +183,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=("table", "json", "markdown"), default="table")
     p.add_argument("--json", action="store_true", help="the same as --format json")
     p.add_argument("--fail-on-regression", action="store_true", help="exit 1 when a newest run sits after a regression")
-    p.add_argument("--max-pvalue", type=_probability, default=DEFAULT_MAX_PVALUE, help="in (0, 1]")
-    p.add_argument("--min-change", type=_fraction, default=DEFAULT_MIN_CHANGE,
+    p.add_argument("--max-pvalue", type=probability, default=DEFAULT_MAX_PVALUE, help="in (0, 1]")
+    p.add_argument("--min-change", type=fraction, default=DEFAULT_MIN_CHANGE,
                    help="relative, >= 0; smaller steps are merged away")
     p.add_argument("--otava-only", action="store_true",
                    help="Otava for instruction-count series too (default: their exact steps)")
