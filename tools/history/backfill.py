@@ -10,7 +10,6 @@ measurement is re-used for it and marked so in the run's context (`measured_at`)
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import os

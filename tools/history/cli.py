@@ -14,7 +14,7 @@ import signal
 import sqlite3
 import sys
 
-from .text import md_cell, term
+from .text import term
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_DB = os.path.join(ROOT, "results", "history", "history.sqlite")
