@@ -286,6 +286,8 @@ def test_render_report_with_a_list_for_a_name_or_a_huge_size(tmp_path):
     assert "strategy" in one_line_error(hist("record", "--db", tmp_path / "h.sqlite", "--date", "2026-01-01", p))
     p.write_text(json.dumps(report | {"strategy": "pixel", "width": 2 ** 64}))
     assert "width" in one_line_error(hist("record", "--db", tmp_path / "h.sqlite", "--date", "2026-01-01", p))
+    p.write_text(json.dumps(report | {"strategy": "pixel", "seconds": -0.5}))
+    assert "negative" in one_line_error(hist("record", "--db", tmp_path / "h.sqlite", "--date", "2026-01-01", p))
 
 
 # ---- record and rebuild: all or nothing, no leftovers ------------------------------------------------

@@ -246,7 +246,7 @@ def _render_result(path: str, rep: dict) -> dict:
             raise RecordError(f"{path}: render report lacks '{k}'")
     s = {k: text(rep[k], f"{path}: {k}", limit=256) for k in ("device", "strategy", "scene", "sampling")}
     n = {k: integer(rep[k], f"{path}: {k}") for k in ("width", "height", "spp", "bounces")}
-    seconds = real(rep["seconds"], f"{path}: seconds", optional=False)
+    seconds = _non_negative(real(rep["seconds"], f"{path}: seconds", optional=False), f"{path}: seconds")
     name = (f"render/{s['device']}/{s['strategy']}/{s['scene']}/{n['width']}x{n['height']}"
             f"/spp:{n['spp']}/bounces:{n['bounces']}/{s['sampling']}")
     counters = {k: real(v, f"{path}: {k}") for k, v in rep.items()
