@@ -62,49 +62,56 @@ def one_input(data: bytes) -> None:
     with open(path, "wb") as f:
         f.write(data[1:] if data[:1] == b"r" else data)
     try:
-        if data[:1] == b"r":
-            run = export.read_run(path)
-        else:
-            run = importer.parse(path)
-        _check_terminal(text.term(run["source"]) + text.term(run["machine_name"]) +
-                        "".join(text.term(r["benchmark"]) for r in run["results"]), "names", newline_ok=False)
-        db = store.connect(":memory:")
-        try:
-            importer.insert_all(db, [run], export_dir=os.path.join(TMP, "runs"))
-            # Two more runs of the same series (other commits, values scaled by data's last byte),
-            # so change points are computed on three points: Otava and the exact steps run too.
-            factor = 1 + (data[-1] if data else 0) / 64
-            for k, f in enumerate((factor, 1 / factor)):
-                more = dict(run, run_key=f"{k + 1:064x}", commit=f"{k + 1:040x}", run_date=f"9999-12-3{k}T00:00:00+00:00",
-                            commit_date=None, results=[dict(r, value=_times(r["value"], f)) for r in run["results"]])
-                importer.insert_all(db, [more])
-            # The run file reads back as the same run, and rebuilds to the same rows.
-            written = os.path.join(TMP, "runs", export.file_name(run))
-            back = export.read_run(written)
-            os.remove(written)
-            for k in export.HEADER_KEYS:
-                if back.get(k) != run.get(k) and not (k == "source" and not run.get(k)):
-                    raise Finding(f"run file round trip changed {k}: {run.get(k)!r:.100} -> {back.get(k)!r:.100}")
-            if sorted(back["results"], key=_key) != sorted(run["results"], key=_key):
-                raise Finding("run file round trip changed the results")
-            found = changes.find(db)
-            table, md = changes.format_table(found), changes.format_markdown(found)
-            _check_terminal(table, "changes table")
-            if found and table.count("\n") != len(found):
-                raise Finding("the changes table has a line more or less than its changes")
-            for line in md.split("\n")[2:]:
-                _check_terminal(line, "markdown")
-                if line.count("|") - line.count("\\|") != 7:
-                    raise Finding(f"a Markdown row has the wrong number of cells: {line!r:.200}")
-            site = report.collect(db)
-            page = report._page(site)
-            blob = page.split('type="application/json">', 1)[1].rsplit("</script>", 2)[0]
-            if re.search("[<>\u2028\u2029]", blob):
-                raise Finding("the inline data holds a raw '<', '>' or U+2028/9")
-        finally:
-            db.close()
+        run = export.read_run(path) if data[:1] == b"r" else importer.parse(path)
     except store.UserError:
-        pass  # a clean refusal: exit 2 with one line
+        return  # a clean refusal: exit 2 with one line
+    # Past this point the run was accepted: every later refusal is a finding too (a run the
+    # history took must store, export, read back, and show).
+    try:
+        follow(run, data)
+    except store.UserError as e:
+        raise Finding(f"an accepted run was refused later: {e}") from e
+
+
+def follow(run: dict, data: bytes) -> None:
+    _check_terminal(text.term(run["source"]) + text.term(run["machine_name"]) +
+                    "".join(text.term(r["benchmark"]) for r in run["results"]), "names", newline_ok=False)
+    db = store.connect(":memory:")
+    try:
+        importer.insert_all(db, [run], export_dir=os.path.join(TMP, "runs"))
+        # Two more runs of the same series (other commits, values scaled by data's last byte),
+        # so change points are computed on three points: Otava and the exact steps run too.
+        factor = 1 + (data[-1] if data else 0) / 64
+        for k, f in enumerate((factor, 1 / factor)):
+            more = dict(run, run_key=f"{k + 1:064x}", commit=f"{k + 1:040x}", run_date=f"9999-12-3{k}T00:00:00+00:00",
+                        commit_date=None, results=[dict(r, value=_times(r["value"], f)) for r in run["results"]])
+            if not importer.recorded(db, more["run_key"]):
+                importer.insert_all(db, [more])
+        # The run file reads back as the same run.
+        written = os.path.join(TMP, "runs", export.file_name(run))
+        back = export.read_run(written)
+        os.remove(written)
+        for k in export.HEADER_KEYS:
+            if back.get(k) != run.get(k) and not (k == "source" and not run.get(k)):
+                raise Finding(f"run file round trip changed {k}: {run.get(k)!r:.100} -> {back.get(k)!r:.100}")
+        if sorted(back["results"], key=_key) != sorted(run["results"], key=_key):
+            raise Finding("run file round trip changed the results")
+        found = changes.find(db)
+        table, md = changes.format_table(found), changes.format_markdown(found)
+        _check_terminal(table, "changes table")
+        if found and table.count("\n") != len(found):
+            raise Finding("the changes table has a line more or less than its changes")
+        for line in md.split("\n")[2:]:
+            _check_terminal(line, "markdown")
+            if line.count("|") - line.count("\\|") != 7:
+                raise Finding(f"a Markdown row has the wrong number of cells: {line!r:.200}")
+        site = report.collect(db)
+        page = report._page(site)
+        blob = page.split('type="application/json">', 1)[1].rsplit("</script>", 2)[0]
+        if re.search("[<>\u2028\u2029]", blob):
+            raise Finding("the inline data holds a raw '<', '>' or U+2028/9")
+    finally:
+        db.close()
 
 
 def _times(v, f):
