@@ -10,6 +10,7 @@ import signal
 import sqlite3
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -621,3 +622,39 @@ def test_a_lock_held_past_the_busy_timeout_is_exit_2_and_leaves_nothing(tmp_path
         holder.close()
     assert "database is locked" in one_line_error(r)
     assert count(db) == 1 and (not ex.exists() or list(ex.iterdir()) == []) and leftovers(tmp_path) == []
+
+
+def test_a_signal_during_a_long_lock_wait_ends_the_run_quickly_and_leaves_nothing(tmp_path):
+    """SIGTERM while `record` waits in sqlite's busy handler (C code, where Python signal handlers do
+    not run): ended within the grace time, its staged run file removed, the database untouched."""
+    db, ex = record_db(tmp_path), tmp_path / "runs"
+    before = db.read_bytes()
+    holder = sqlite3.connect(db, isolation_level=None)
+    holder.execute("BEGIN IMMEDIATE")  # readers go on: record stages its run file, then waits to write
+    try:
+        proc = subprocess.Popen([sys.executable, "-m", "history", "record", "--db", str(db), "--export", str(ex),
+                                 str(bench(tmp_path / "b.json", git_revision="2" * 40))], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, env=os.environ | {"PYTHONPATH": TOOLS})
+        for _ in range(200):  # until its run file is staged: it is then waiting for the lock
+            if ex.exists() and list(ex.iterdir()):
+                break
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        t0 = time.monotonic()
+        rc = proc.wait(timeout=60)
+        waited = time.monotonic() - t0
+        err = proc.stderr.read()
+        proc.stdout.close()
+        proc.stderr.close()
+    finally:
+        holder.execute("ROLLBACK")
+        holder.close()
+    assert rc == 143 and "stopped by signal 15" in err and err.count("\n") == 1, err
+    assert waited < 15 and list(ex.iterdir()) == [] and leftovers(tmp_path) == [] and db.read_bytes() == before
+
+
+def test_a_fifo_given_as_the_database_is_refused_not_waited_on(tmp_path):
+    fifo = tmp_path / "h.sqlite"
+    os.mkfifo(fifo)
+    for args in (["changes"], ["record", QUICK], ["report", "--out", tmp_path / "site"]):
+        assert "not a regular file" in one_line_error(hist(*args[:1], "--db", fifo, *args[1:], timeout=30))

@@ -239,6 +239,56 @@ def _on_signal(signum, frame):
     raise Stopped(signum)
 
 
+SIGNALS = (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)
+GRACE_S = 5.0  # how long a signalled run may take to unwind before it is ended anyway
+
+
+def _watch(done) -> None:
+    """Receives SIGTERM/SIGHUP/SIGINT for the main thread (which blocks them): asks the main
+    thread to stop (Stopped at its next bytecode, so every finally runs), and where it does not
+    finish within GRACE_S (stuck in C: a sqlite busy wait can last the whole busy timeout), removes
+    what this process made (store.TEMPORARY) and ends it. A database write in progress is safe:
+    sqlite's journal rolls it back."""
+    import _thread
+    from . import store
+    while not done.is_set():
+        info = signal.sigtimedwait(SIGNALS, 0.25)
+        if info is not None:
+            break
+    else:
+        return  # the run finished: this watcher ends with it
+    signum = info.si_signo
+    _thread.interrupt_main(signum)
+    if not done.wait(GRACE_S):
+        store.remove_temporary()
+        print(f"{PROG}: stopped by signal {signum}; nothing stored", file=sys.stderr, flush=True)
+        os._exit(128 + signum)
+
+
+def _arm_signals():
+    """Signal handling for the subcommands that write (not backfill/instructions, whose child
+    processes keep the default). Returns a function that disarms it."""
+    import threading
+    previous = {}
+    try:
+        for sig in SIGNALS:
+            previous[sig] = signal.signal(sig, _on_signal)
+        signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    except (ValueError, OSError, AttributeError):  # not the main thread, or no pthread_sigmask
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        return lambda: None
+    done = threading.Event()
+    threading.Thread(target=_watch, args=(done,), daemon=True).start()
+
+    def disarm():
+        done.set()
+        for sig, handler in previous.items():  # then a signal still pending gets the default action
+            signal.signal(sig, handler)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
+    return disarm
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs one subcommand and maps every way it can end to the exit status contract (module doc)."""
     import warnings
@@ -251,15 +301,11 @@ def main(argv: list[str] | None = None) -> int:
             stream.reconfigure(errors="backslashreplace")
         except (AttributeError, ValueError):
             pass
-    previous = {}
-    for sig in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT):
-        try:
-            previous[sig] = signal.signal(sig, _on_signal)
-        except (ValueError, OSError):  # not the main thread
-            pass
     db = None
+    argv = sys.argv[1:] if argv is None else argv
+    disarm = _arm_signals() if next((a for a in argv if not a.startswith("-")), None) in \
+        ("record", "rebuild", "changes", "report") else (lambda: None)
     try:
-        argv = sys.argv[1:] if argv is None else argv
         for i, a in enumerate(argv):  # the --db given, to name it in a database error
             if a == "--db" and i + 1 < len(argv):
                 db = argv[i + 1]
@@ -293,5 +339,4 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: internal error: {term(type(e).__name__)}: {term(str(e))[:500]}", file=sys.stderr)
         return 3
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        disarm()

@@ -36,11 +36,13 @@ def stage_run(folder: str, run: dict) -> tuple[str, str]:
     os.makedirs(folder, exist_ok=True)
     final = os.path.join(folder, file_name(run))
     fd, tmp = tempfile.mkstemp(prefix=".", suffix=".jsonl.tmp", dir=folder)
+    store.TEMPORARY.add(tmp)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(_lines(run))
     except BaseException:
         os.remove(tmp)
+        store.TEMPORARY.discard(tmp)
         raise
     return tmp, final
 
@@ -48,6 +50,7 @@ def stage_run(folder: str, run: dict) -> tuple[str, str]:
 def write_run(folder: str, run: dict) -> str:
     tmp, final = stage_run(folder, run)
     os.replace(tmp, final)
+    store.TEMPORARY.discard(tmp)
     return final
 
 
@@ -90,6 +93,7 @@ def rebuild(folder: str, db_path: str) -> int:
     os.makedirs(folder_of_db, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(db_path) + ".", suffix=".rebuild", dir=folder_of_db)
     os.close(fd)
+    store.TEMPORARY.add(tmp)
     try:
         os.remove(tmp)  # sqlite makes the file itself; the name stays ours
         db = store.connect(tmp)
@@ -99,7 +103,5 @@ def rebuild(folder: str, db_path: str) -> int:
             db.close()
         os.replace(tmp, db_path)  # the old database stays until the new one is complete
     finally:
-        for leftover in (tmp, tmp + "-journal", tmp + "-wal", tmp + "-shm"):
-            if os.path.exists(leftover):
-                os.remove(leftover)
+        store.remove_temporary_one(tmp)
     return len(files)

@@ -440,6 +440,7 @@ def insert_all(db, runs: list[dict], export_dir: str | None = None, skip_recorde
                     tmp, final = staged.pop(run["run_key"])
                     existed = os.path.exists(final)
                     os.replace(tmp, final)
+                    store.TEMPORARY.discard(tmp)
                     if not existed:
                         placed.append(final)
             db.execute("COMMIT")
@@ -450,7 +451,7 @@ def insert_all(db, runs: list[dict], export_dir: str | None = None, skip_recorde
             raise
     finally:
         for tmp, _ in staged.values():  # runs skipped, or everything after a failure
-            _remove(tmp)
+            store.remove_temporary_one(tmp)
     return stored
 
 

@@ -21,7 +21,7 @@ import tempfile
 import urllib.parse
 
 from . import changes as cp
-from .store import UserError
+from .store import TEMPORARY, UserError, remove_temporary_one
 from .text import script_json
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -206,6 +206,7 @@ def write_site(db, out: str, commit_url: str = "", png: bool = True, repo: str |
     parent = os.path.dirname(os.path.abspath(out))
     os.makedirs(parent, exist_ok=True)
     tmp = tempfile.mkdtemp(prefix="." + os.path.basename(os.path.abspath(out)) + ".", dir=parent)
+    TEMPORARY.add(tmp)
     try:
         for name in ("dashboard.js", "dashboard.css"):
             shutil.copy(os.path.join(HERE, name), os.path.join(tmp, name))
@@ -226,5 +227,5 @@ def write_site(db, out: str, commit_url: str = "", png: bool = True, repo: str |
         for name in names:
             os.replace(os.path.join(tmp, name), os.path.join(out, name))
     finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        remove_temporary_one(tmp)
     return len(data["series"])

@@ -13,6 +13,7 @@ import json
 import os
 import pathlib
 import sqlite3
+import stat
 
 SCHEMA_VERSION = 1
 # How long a writer waits for another one to finish (sqlite's busy timeout, seconds). The largest
@@ -73,6 +74,32 @@ VOLATILE = {"load", "load_avg", "load_average", "load_average_at_start", "date",
 FALLBACK_KEYS = ("host_name", "cpu_model", "num_cpus", "mhz_per_cpu", "caches")
 
 
+# Temporary files and folders this process made and has not yet renamed or removed (staged run
+# files, a database being rebuilt, a site being written). The CLI's signal watcher removes them
+# where a signal arrives while the main thread is stuck in C (a sqlite busy wait) and cannot
+# unwind through its finally blocks in time.
+TEMPORARY: set[str] = set()
+
+
+def remove_temporary_one(path: str) -> None:
+    """path (a file, a folder, or a database with its journal) removed and forgotten."""
+    import shutil
+    for p in (path, path + "-journal", path + "-wal", path + "-shm"):
+        try:
+            if os.path.isdir(p) and not os.path.islink(p):
+                shutil.rmtree(p, ignore_errors=True)
+            else:
+                os.remove(p)
+        except OSError:
+            pass
+    TEMPORARY.discard(path)
+
+
+def remove_temporary() -> None:
+    for path in list(TEMPORARY):
+        remove_temporary_one(path)
+
+
 class UserError(Exception):
     """Bad input or a bad database: `pathbench history` prints it as one line and exits 2."""
 
@@ -122,6 +149,8 @@ def connect(path: str, create: bool = True, readonly: bool = False) -> sqlite3.C
     sqlite3.Error: the CLI names the database and exits 2."""
     if os.path.isdir(path):
         raise UserError(f"{path}: is a folder, not a history database")
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):  # sqlite would block on a FIFO
+        raise UserError(f"{path}: not a regular file, so not a history database")
     if not create and not os.path.exists(path):
         raise UserError(f"{path}: no history database (record runs or run `history rebuild`)")
     if create and os.path.dirname(path):
