@@ -551,7 +551,9 @@ def test_dashboard_first_screen_is_the_headline_plots_with_the_table_collapsed(t
     hist("report", "--db", db, "--out", site, "--no-png", check=0)
     dom, console = _dom(tmp_path, site)
     assert console == []
-    assert 'data-headline="3"' in dom and 'data-drawn="4"' in dom
+    # One chart per machine and device (CPU: pixel and wavefront as two coloured lines; GPU), then every series.
+    assert 'data-headline="2"' in dom and 'data-drawn="4"' in dom
+    assert dom.count('class="median c0"') == 1 and dom.count('class="median c1"') == 1
     assert dom.index('id="headline"') < dom.index('id="summary-box"') < dom.index('id="plots"')
     details = dom[dom.index("<details"):].split(">")[0]
     assert "open" not in details
