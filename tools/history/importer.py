@@ -321,7 +321,8 @@ def parse(path: str, commit: str | None = None, date: str | None = None, machine
         "preset": context.get("pathbench_preset"), "film_hash": film_hash,
         "source": os.path.basename(path)[:MAX_TEXT], "context": context, "results": results,
     }
-    return validate_run(run, path, check_results=False)  # the rows: checked by _bench_results/_render_result
+    # The same gate as a run file read back, rows included: what record takes, rebuild takes.
+    return validate_run(run, path)
 
 
 _HEX = re.compile(r"[0-9a-f]+")
