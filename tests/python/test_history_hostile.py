@@ -660,3 +660,14 @@ def test_a_fifo_given_as_the_database_is_refused_not_waited_on(tmp_path):
     os.mkfifo(fifo)
     for args in (["changes"], ["record", QUICK], ["report", "--out", tmp_path / "site"]):
         assert "not a regular file" in one_line_error(hist(*args[:1], "--db", fifo, *args[1:], timeout=30))
+
+
+def test_a_missing_tool_package_is_named_in_one_line(tmp_path):
+    """Otava absent (as in a Python without tools/requirements.txt): exit 2 naming it, not a traceback."""
+    db = tmp_path / "h.sqlite"
+    hist("record", "--db", db, "--export", "", *_instruction_runs(tmp_path, "x"), check=0)
+    code = ("import sys; sys.modules['otava'] = None\n"
+            "from history import cli\n"
+            f"sys.exit(cli.main(['changes', '--otava-only', '--db', {str(db)!r}]))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=os.environ | {"PYTHONPATH": TOOLS})
+    assert "otava" in one_line_error(r) and "requirements.txt" in r.stderr

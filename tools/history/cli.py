@@ -324,6 +324,9 @@ def main(argv: list[str] | None = None) -> int:
                 pass
             return 0
         return _err(_oserror(e))
+    except ModuleNotFoundError as e:  # otava, matplotlib: an environment without the tools' packages
+        return _err(f"needs the Python package providing '{e.name}' ({sys.executable}): "
+                    "pip install -r tools/requirements.txt")
     except Stopped as e:
         print(f"{PROG}: stopped by signal {e.signum}; nothing stored", file=sys.stderr)
         return 128 + e.signum
