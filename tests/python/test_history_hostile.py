@@ -487,7 +487,9 @@ def test_internal_errors_are_exit_3_in_one_line(tmp_path):
 @pytest.mark.parametrize("args", [["record"], ["changes", "--max-pvalue", "nan"], ["changes", "--min-change", "-1"],
                                   ["frobnicate"], ["changes", "--benchmark", "("], ["report"],
                                   ["report", "--out", "x", "--commit-url", "javascript:alert(1)//{}"],
-                                  ["report", "--out", "x", "--commit-url", 'https://h/{}"></script><script>alert(1)']])
+                                  ["report", "--out", "x", "--commit-url", 'https://h/{}"></script><script>alert(1)'],
+                                  ["report", "--out", "x", "--commit-url", "https://[::1/{}"],
+                                  ["report", "--out", "x", "--commit-url", "https://h:port/{}"]])
 def test_usage_errors_are_one_line(tmp_path, args):
     db = record_db(tmp_path)
     one_line_error(hist(*args, "--db", db, cwd=tmp_path))

@@ -67,7 +67,12 @@ def check_commit_url(url: str | None) -> str:
     if not url:
         return ""
     bad = re.search(r"[\x00-\x20\x7f-\x9f\"'<>\\^`|]", url)
-    parts = urllib.parse.urlsplit(url.replace("{}", "0"))
+    try:
+        parts = urllib.parse.urlsplit(url.replace("{}", "0"))
+        parts.port  # noqa: B018  (raises on a port that is not a number)
+    except ValueError:  # "https://[::1" and other hosts urllib cannot split
+        bad = True
+        parts = urllib.parse.urlsplit("")
     if bad or parts.scheme.lower() not in ("http", "https") or not parts.netloc or url.count("{}") > 1 \
             or re.search(r"[{}]", url.replace("{}", "")):
         raise UserError(f"--commit-url: {url[:80]!r} is not an http(s) URL template (like https://host/repo/commit/{{}})")
