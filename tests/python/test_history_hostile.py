@@ -593,6 +593,9 @@ def test_backfill_range_is_never_an_option(tmp_path):
         assert r.returncode == 2 and "not a revision range" in r.stderr and r.stderr.count("\n") == 1, r.stderr
     assert not list(tmp_path.glob("created-by-git*"))
     one_line_error(hist("backfill", "--wall", "many"))
+    (tmp_path / "afile").write_text("x")
+    assert "git log" in one_line_error(hist("backfill", "--db", tmp_path / "h.sqlite", "--repo", tmp_path / "afile",
+                                            "--git-results", tmp_path / "afile"))
 
 
 def test_a_database_edited_to_hold_text_for_a_value_is_exit_2(tmp_path):
