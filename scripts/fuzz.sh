@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target for a bounded time and fails on any finding: a crash, a
 # sanitizer report (ASan + UBSan), a leak, a slow input (> 10 s) or one over 2 GB.
-#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | off | all
+#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | off | history | all
+# (history: the Python history's readers, tests/fuzz/python/fuzz_history.py under atheris)
 # Builds build-fuzz/ with clang first (-DPATHBENCH_FUZZ=ON). The seed corpus is
 # tests/fuzz/corpus/TARGET (read only); what the fuzzer learns goes to
 # build-fuzz/corpus/TARGET and is kept between runs; a failing input is written to
@@ -10,8 +11,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
-targets="scene_json obj bench_json ply gltf mitsuba off"
-target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|off|all SECONDS}
+targets="scene_json obj bench_json ply gltf mitsuba off history"
+target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|off|history|all SECONDS}
 seconds=${2:?usage: scripts/fuzz.sh TARGET SECONDS}
 build=${PATHBENCH_FUZZ_BUILD:-build-fuzz}
 
@@ -19,6 +20,20 @@ if [ "$target" = all ]; then
   count=$(echo $targets | wc -w)
   each=$(( seconds / count > 0 ? seconds / count : 1 ))
   for t in $targets; do "$0" "$t" "$each"; done
+  exit 0
+fi
+if [ "$target" = history ]; then  # Python, no build: atheris, else a seeded mutation loop
+  py=${PATHBENCH_PYTHON:-.venv/bin/python}
+  mkdir -p "$build/corpus/history" "$build/artifacts/history"
+  echo "[fuzz] history for $seconds s"
+  if ! "$py" -c "import atheris" 2>/dev/null; then
+    echo "[fuzz] history: atheris not installed (tools/requirements.txt): seeded mutation instead"
+    exec "$py" tests/fuzz/python/fuzz_history.py --mutate "$seconds" tests/fuzz/corpus/history
+  fi
+  # shellcheck disable=SC2086
+  "$py" tests/fuzz/python/fuzz_history.py "$build/corpus/history" tests/fuzz/corpus/history \
+    -dict=tests/fuzz/history.dict -max_total_time="$seconds" -max_len=65536 -timeout=10 \
+    -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/history/" ${FUZZ_FLAGS:-} 2>&1 | tail -n 40
   exit 0
 fi
 case "$target" in

@@ -10,7 +10,6 @@ measurement is re-used for it and marked so in the run's context (`measured_at`)
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import os
@@ -59,13 +58,18 @@ def build(scratch: str, build_dir: str, log) -> bool:
 
 def run(repo: str, rev_range: str, scratch: str, json_dir: str, db: str | None, wall: int,
         machine: str | None, log_path: str | None, export_dir: str | None = None) -> int:
+    if not rev_range or rev_range.startswith("-") or any(c.isspace() or ord(c) < 32 for c in rev_range):
+        print(f"pathbench history backfill: error: {rev_range[:80]!r}: not a revision range", file=sys.stderr)
+        return 2
     try:
-        revs = _git(repo, "rev-list", "--reverse", "--first-parent", rev_range).split()
+        revs = _git(repo, "rev-list", "--reverse", "--first-parent", "--end-of-options", rev_range).split()
     except subprocess.CalledProcessError as e:
-        print(f"backfill: {rev_range}: not a revision range in {repo}: {e.stderr.strip()}", file=sys.stderr)
+        detail = " ".join(e.stderr.split())[:200]
+        print(f"pathbench history backfill: error: {rev_range[:80]!r}: not a revision range in {repo}: {detail}",
+              file=sys.stderr)
         return 2
     if not revs:
-        print(f"backfill: {rev_range}: no commits in this range", file=sys.stderr)
+        print(f"pathbench history backfill: error: {rev_range[:80]!r}: no commits in this range", file=sys.stderr)
         return 2
     os.makedirs(json_dir, exist_ok=True)
     if not os.path.isdir(os.path.join(scratch, ".git")):
@@ -155,7 +159,8 @@ def import_git(repo: str, paths: list[str], db: str, export_dir: str | None, mac
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pathbench history backfill", description=__doc__.split("\n\n")[0])
+    from .cli import _Parser  # usage errors as one line, exit 2
+    ap = _Parser(prog="pathbench history backfill", description=__doc__.split("\n\n")[0])
     ap.add_argument("range", nargs="?", help="git revision range, e.g. HEAD~45..HEAD")
     ap.add_argument("--git-results", nargs="+", metavar="JSON",
                     help="instead of building: record every committed version of these bench JSON files (needs --db)")
@@ -170,12 +175,17 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.git_results:
         if not a.db:
-            print("backfill: --git-results needs --db", file=sys.stderr)
+            print("pathbench history backfill: error: --git-results needs --db", file=sys.stderr)
             return 2
-        import_git(os.path.abspath(a.repo), a.git_results, a.db, a.export, a.machine)
+        try:
+            import_git(os.path.abspath(a.repo), a.git_results, a.db, a.export, a.machine)
+        except subprocess.CalledProcessError as e:  # not a repository, a path outside it
+            from .store import UserError
+            detail = " ".join((e.stderr or "").split())[:200] if isinstance(e.stderr, str) else ""
+            raise UserError(f"{a.repo}: git {' '.join(e.cmd[3:5])} failed: {detail}") from None
         return 0
     if not a.range:
-        print("backfill: give a revision range (or --git-results)", file=sys.stderr)
+        print("pathbench history backfill: error: give a revision range (or --git-results)", file=sys.stderr)
         return 2
     return run(os.path.abspath(a.repo), a.range, os.path.abspath(a.scratch), os.path.abspath(a.json_dir),
                a.db, a.wall, a.machine, a.log, a.export)

@@ -17,11 +17,13 @@ away by Otava itself.
 """
 from __future__ import annotations
 
+import math
 import re
 import statistics
 from dataclasses import asdict, dataclass
 
 from . import store
+from .text import md_cell, term
 
 DEFAULT_MAX_PVALUE = 1e-4  # 0 false positives in 100 noise-only series (false_positives.py)
 DEFAULT_MIN_CHANGE = 0.005  # 0.5%: below it, a step is not worth a reviewer's time
@@ -37,7 +39,20 @@ class Point:
 
     @property
     def median(self) -> float:
-        return statistics.median(self.values)
+        return median(self.values)
+
+
+def median(values: list[float]) -> float:
+    """statistics.median, but halves added (not the sum halved): no overflow near the double range."""
+    s = sorted(values)
+    n = len(s)
+    return s[n // 2] if n % 2 else s[n // 2 - 1] / 2 + s[n // 2] / 2
+
+
+def mean(values: list[float]) -> float:
+    """The mean, computed in units of the largest magnitude so that huge values cannot overflow."""
+    scale = max((abs(v) for v in values), default=0.0) or 1.0
+    return statistics.fmean(v / scale for v in values) * scale
 
 
 @dataclass
@@ -69,6 +84,11 @@ def series(db, benchmark: str | None = None, machine: str | None = None) -> dict
     pattern = re.compile(benchmark) if benchmark else None
     out: dict[tuple[str, str], list[Point]] = {}
     for bench, mid, preset, rid, commit, date, value in rows:
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or not isinstance(bench, str):
+            # Only a database edited by hand (or damaged) holds these: record never writes them.
+            raise store.UserError(f"the database holds a value that is not a number (run {rid}, {str(bench)[:80]}): "
+                                  "rebuild it from the run files")
+        commit, date, preset = str(commit), str(date), str(preset)
         if pattern and not pattern.search(bench):
             continue
         pts = out.setdefault((bench, mid, preset), [])
@@ -81,25 +101,29 @@ def series(db, benchmark: str | None = None, machine: str | None = None) -> dict
 
 def detect(values: list[float], max_pvalue: float = DEFAULT_MAX_PVALUE, min_change: float = DEFAULT_MIN_CHANGE):
     """[(index of the first point after the change, relative change, p)] by Otava."""
-    from otava.analysis import compute_change_points  # imported late: `record` works without it
     if len(values) < 3:
         return []
     if max(values) == min(values):
         return []  # a flat series (instruction counts of unchanged code): Otava's t-test would give NaN
-    cps, _ = compute_change_points([float(v) for v in values], window_len=WINDOW, max_pvalue=max_pvalue,
+    from otava.analysis import compute_change_points  # imported late: `record` works without it
+    # Relative changes and the t-test do not depend on the unit: scaled to the largest value, a
+    # series of huge numbers cannot overflow inside Otava.
+    scale = max(abs(v) for v in values) or 1.0
+    cps, _ = compute_change_points([float(v) / scale for v in values], window_len=WINDOW, max_pvalue=max_pvalue,
                                    min_magnitude=min_change)
-    return [(int(c.index), float(c.stats.forward_rel_change()), float(c.stats.pvalue)) for c in cps]
+    out = [(int(c.index), float(c.stats.forward_rel_change()), float(c.stats.pvalue)) for c in cps]
+    return [o for o in out if math.isfinite(o[1]) and math.isfinite(o[2])]
 
 
 def exact_steps(values: list[float], min_change: float = DEFAULT_MIN_CHANGE):
     """[(index, relative change, None)] wherever a noise-free value moves by more than min_change."""
-    return [(i, values[i] / values[i - 1] - 1, None) for i in range(1, len(values))
-            if values[i - 1] and abs(values[i] / values[i - 1] - 1) > min_change]
+    steps = [(i, values[i] / values[i - 1] - 1, None) for i in range(1, len(values)) if values[i - 1]]
+    return [s for s in steps if math.isfinite(s[1]) and abs(s[1]) > min_change]
 
 
 def find(db, benchmark=None, machine=None, max_pvalue=DEFAULT_MAX_PVALUE, min_change=DEFAULT_MIN_CHANGE,
          exact: bool = True) -> list[Change]:
-    names = dict(db.execute("SELECT id, name FROM machines").fetchall())
+    names = {k: str(v) for k, v in db.execute("SELECT id, name FROM machines").fetchall()}
     units = dict(db.execute("SELECT benchmark, MAX(unit) FROM results GROUP BY benchmark").fetchall())
     found = []
     for (bench, mid, preset), pts in sorted(series(db, benchmark, machine).items()):
@@ -111,7 +135,7 @@ def find(db, benchmark=None, machine=None, max_pvalue=DEFAULT_MAX_PVALUE, min_ch
             # Means of the segments on either side (between neighbouring change points).
             before, after = medians[bounds[k]:idx], medians[idx:bounds[k + 2]]
             found.append(Change(bench, names[mid], mid, preset, pts[idx].commit, pts[idx - 1].commit, idx, change, p,
-                                statistics.fmean(before), statistics.fmean(after), change > 0,
+                                mean(before), mean(after), change > 0,
                                 "exact" if deterministic else "otava"))
     return found
 
@@ -131,11 +155,26 @@ def as_json(changes: list[Change]) -> list[dict]:
 
 
 def format_table(changes: list[Change]) -> str:
+    """For a terminal: names escaped (text.term), so a name cannot forge or hide a line."""
     if not changes:
         return "no change points"
     lines = [f"{'change':>8}  {'p':>8}  {'commit':12}  {'previous':12}  machine  benchmark"]
     for c in changes:
         p = "exact" if c.p_value is None else f"{c.p_value:8.1e}"
-        lines.append(f"{c.change * 100:+7.2f}%  {p:>8}  {c.commit[:12]:12}  {c.previous_commit[:12]:12}  "
-                     f"{c.machine}  {c.benchmark}")
+        lines.append(f"{c.change * 100:+7.2f}%  {p:>8}  {term(c.commit[:12]):12}  {term(c.previous_commit[:12]):12}  "
+                     f"{term(c.machine)}  {term(c.benchmark)}")
+    return "\n".join(lines)
+
+
+def format_markdown(changes: list[Change]) -> str:
+    """A Markdown table (for a pull request or a CI summary): cells escaped (text.md_cell), so a
+    `|` or a newline in a name neither splits a cell nor starts a row."""
+    if not changes:
+        return "no change points"
+    lines = ["| change | p | commit | previous | machine | benchmark |", "|---:|---:|---|---|---|---|"]
+    for c in changes:
+        p = "exact" if c.p_value is None else f"{c.p_value:.1e}"
+        lines.append(f"| {c.change * 100:+.2f}% | {p} | `{md_cell(c.commit[:12]).replace('`', '')}` | "
+                     f"`{md_cell(c.previous_commit[:12]).replace('`', '')}` | {md_cell(c.machine)} | "
+                     f"{md_cell(c.benchmark)} |")
     return "\n".join(lines)

@@ -188,7 +188,12 @@ def measure(exe: str, wall_reps: int = 0, revision: str | None = None, width: in
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    class Parser(argparse.ArgumentParser):  # a usage error in one line, exit 2 (docs/history.md)
+        def error(self, message):
+            print(f"pathbench history instructions: error: {message}", file=sys.stderr)
+            sys.exit(2)
+
+    ap = Parser(prog="pathbench history instructions", description=__doc__.split("\n\n")[0])
     ap.add_argument("--build-dir", default="build", help="build folder holding bin/pathbench")
     ap.add_argument("--out", required=True, help="JSON file to write")
     ap.add_argument("--wall", type=int, default=0, metavar="N", help="also N native timed renders per series")

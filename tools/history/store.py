@@ -11,9 +11,24 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import pathlib
 import sqlite3
+import stat
 
 SCHEMA_VERSION = 1
+# How long a writer waits for another one to finish (sqlite's busy timeout, seconds). The largest
+# run a file may hold (32 MiB, ~165,000 rows) holds the lock ~4 s on the loaded 2-core VM; a
+# 4,000-row run well under one. 120 s lets ten writers of the largest runs queue with room to
+# spare, and still ends (exit 2, "database is locked") where a writer hangs holding the lock.
+def _busy_timeout(default: float = 120.0) -> float:
+    try:
+        v = float(os.environ.get("PATHBENCH_HISTORY_BUSY_TIMEOUT", default))
+    except ValueError:
+        return default
+    return v if 0 <= v <= 86400 else default
+
+
+BUSY_TIMEOUT_S = _busy_timeout()
 
 SCHEMA = """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -59,7 +74,37 @@ VOLATILE = {"load", "load_avg", "load_average", "load_average_at_start", "date",
 FALLBACK_KEYS = ("host_name", "cpu_model", "num_cpus", "mhz_per_cpu", "caches")
 
 
-class SchemaError(Exception):
+# Temporary files and folders this process made and has not yet renamed or removed (staged run
+# files, a database being rebuilt, a site being written). The CLI's signal watcher removes them
+# where a signal arrives while the main thread is stuck in C (a sqlite busy wait) and cannot
+# unwind through its finally blocks in time.
+TEMPORARY: set[str] = set()
+
+
+def remove_temporary_one(path: str) -> None:
+    """path (a file, a folder, or a database with its journal) removed and forgotten."""
+    import shutil
+    for p in (path, path + "-journal", path + "-wal", path + "-shm"):
+        try:
+            if os.path.isdir(p) and not os.path.islink(p):
+                shutil.rmtree(p, ignore_errors=True)
+            else:
+                os.remove(p)
+        except OSError:
+            pass
+    TEMPORARY.discard(path)
+
+
+def remove_temporary() -> None:
+    for path in list(TEMPORARY):
+        remove_temporary_one(path)
+
+
+class UserError(Exception):
+    """Bad input or a bad database: `pathbench history` prints it as one line and exits 2."""
+
+
+class SchemaError(UserError):
     pass
 
 
@@ -92,17 +137,56 @@ def machine_id(context: dict) -> str:
     return hashlib.sha256(canonical(machine_description(context)).encode()).hexdigest()[:16]
 
 
-def connect(path: str, create: bool = True) -> sqlite3.Connection:
+def _statements(script: str) -> list[str]:
+    body = "\n".join(line.split("--")[0] for line in script.splitlines())
+    return [st.strip() for st in body.split(";") if st.strip()]
+
+
+def connect(path: str, create: bool = True, readonly: bool = False) -> sqlite3.Connection:
+    """The database at path; a new one (schema and version) where none exists and create is set.
+    readonly opens it without ever writing (changes, report): a read-only file or folder works.
+    sqlite errors (not a database, truncated, locked past the busy timeout, read-only) propagate as
+    sqlite3.Error: the CLI names the database and exits 2."""
+    if os.path.isdir(path):
+        raise UserError(f"{path}: is a folder, not a history database")
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):  # sqlite would block on a FIFO
+        raise UserError(f"{path}: not a regular file, so not a history database")
+    if not create and not os.path.exists(path):
+        raise UserError(f"{path}: no history database (record runs or run `history rebuild`)")
     if create and os.path.dirname(path):
         os.makedirs(os.path.dirname(path), exist_ok=True)
-    db = sqlite3.connect(path, isolation_level=None)  # transactions explicit (BEGIN/COMMIT)
-    db.execute("PRAGMA foreign_keys = ON")
-    has_meta = db.execute("SELECT 1 FROM sqlite_master WHERE type='table' AND name='meta'").fetchone()
-    if not has_meta:
-        if not create:
-            raise SchemaError(f"{path}: not a pathbench history database")
-        db.executescript("BEGIN;" + SCHEMA + f"INSERT INTO meta VALUES ('schema_version', '{SCHEMA_VERSION}');COMMIT;")
-    version = db.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
-    if version is None or int(version[0]) != SCHEMA_VERSION:
-        raise SchemaError(f"{path}: schema version {version and version[0]}, this pathbench reads {SCHEMA_VERSION}")
+    if readonly:
+        uri = pathlib.Path(os.path.abspath(path)).as_uri() + "?mode=ro"
+        db = sqlite3.connect(uri, uri=True, isolation_level=None, timeout=BUSY_TIMEOUT_S)
+    else:
+        db = sqlite3.connect(path, isolation_level=None, timeout=BUSY_TIMEOUT_S)  # transactions explicit
+    try:
+        db.execute("PRAGMA foreign_keys = ON")
+        has_meta = db.execute("SELECT 1 FROM sqlite_master WHERE type='table' AND name='meta'").fetchone()
+        if not has_meta:
+            if not create or readonly:
+                raise SchemaError(f"{path}: not a pathbench history database")
+            # Two writers may create one new database at once: the second waits, then finds it made.
+            db.execute("BEGIN IMMEDIATE")
+            try:
+                if not db.execute("SELECT 1 FROM sqlite_master WHERE type='table' AND name='meta'").fetchone():
+                    if db.execute("SELECT 1 FROM sqlite_master").fetchone():
+                        raise SchemaError(f"{path}: not a pathbench history database (it holds other tables)")
+                    for st in _statements(SCHEMA):
+                        db.execute(st)
+                    db.execute("INSERT INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
+                db.execute("COMMIT")
+            except BaseException:
+                db.execute("ROLLBACK")
+                raise
+        try:
+            version = db.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+        except sqlite3.Error:
+            version = None
+        if version is None or str(version[0]) != str(SCHEMA_VERSION):
+            shown = "none" if version is None else repr(version[0])[:40]
+            raise SchemaError(f"{path}: schema version {shown}, this pathbench reads {SCHEMA_VERSION}")
+    except BaseException:
+        db.close()
+        raise
     return db
