@@ -10,7 +10,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
-targets="scene_json obj bench_json ply gltf mitsuba"
+targets="scene_json obj bench_json ply gltf mitsuba compare_context"
 target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|all SECONDS}
 seconds=${2:?usage: scripts/fuzz.sh TARGET SECONDS}
 build=${PATHBENCH_FUZZ_BUILD:-build-fuzz}
@@ -22,7 +22,7 @@ if [ "$target" = all ]; then
   exit 0
 fi
 case "$target" in
-  scene_json|bench_json|gltf) dict=tests/fuzz/json.dict ;;
+  scene_json|bench_json|gltf|compare_context) dict=tests/fuzz/json.dict ;;
   obj) dict=tests/fuzz/obj.dict ;;
   ply) dict=tests/fuzz/ply.dict ;;
   mitsuba) dict=tests/fuzz/xml.dict ;;
