@@ -71,6 +71,8 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--report", o.report, "run report (.json)");
   cmd.add_flag("--profile", o.profile, "print a per-stage GPU profile");
   cmd.add_flag("--quiet", o.quiet, "no progress bar and no summary");
+  cmd.footer("Exit status: 0 rendered and written, 2 bad input (a scene or option pathbench refuses, a size past "
+             "its limit, an output path it cannot write; one message, nothing written), 3 an internal failure.");
 }
 
 void finish_render_options(RenderOptions& o) {

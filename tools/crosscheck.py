@@ -136,8 +136,6 @@ def check_arguments(a) -> None:
         raise BadInput(f"--mean-tolerance {a.mean_tolerance}: must be a finite number >= 0")
     if a.out_dir.exists() and not a.out_dir.is_dir():
         raise BadInput(f"--out-dir {a.out_dir}: is a file, not a directory")
-    if not a.xml.is_file():
-        raise BadInput(f"--xml {a.xml}: {'not a regular file' if a.xml.exists() else 'no such file'}")
 
 
 def read_images(specs):
