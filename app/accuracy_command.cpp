@@ -119,8 +119,7 @@ void apply_quick(AccuracyOptions& o) {
 }
 
 void validate(const AccuracyOptions& o) {
-  if (o.width == 0 || o.height == 0)
-    throw InputError(fmt::format("--width/--height: the image must be at least 1x1 (got {}x{})", o.width, o.height));
+  check_image_size(o.width, o.height, true);  // >= 1x1, the pixel limit, the film in memory
   if (o.max_spp == 0) throw InputError("--max-spp: must be at least 1");
   if (o.reference_spp < 2) throw InputError("--reference-spp: must be at least 2 (the reference needs a variance)");
   if (o.reference_spp <= o.max_spp)

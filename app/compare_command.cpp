@@ -13,6 +13,10 @@ void add_compare_options(CLI::App& cmd, CompareOptions& o) {
   cmd.add_flag("--strict", o.strict,
                "refuse (exit 2) when the runs differ in machine fingerprint, build, settings, Embree layout or load");
   cmd.add_option("--format", o.format, "text, json or markdown")->capture_default_str();
+  cmd.footer("Exit status: 0 no regression, 1 some benchmark regressed, 2 bad input (a missing or malformed "
+             "file, a field of the wrong type, no benchmark in common, or --strict and the runs differ; one "
+             "message naming the file and field), 3 an internal failure. Names from the files are shown with "
+             "control characters escaped.");
 }
 
 }  // namespace pb::app

@@ -2,8 +2,9 @@
 // `pathbench crosscheck SCENE`: renders a scene with pathbench (CPU, and GPU where
 // present) and with Mitsuba 3 (the scene exported by mitsuba_export.h, or a Mitsuba XML
 // scene read by Mitsuba itself), and judges each pathbench image against Mitsuba's with
-// the per-pixel z-test the test suite uses (tools/crosscheck.py): a verdict, exit 0
-// (same up to noise) or 1 (different), and difference images.
+// the per-pixel z-test the test suite uses (tools/crosscheck.py): a verdict and
+// difference images. Exit status: 0 same up to noise, 1 different, 2 bad input (then
+// nothing this run wrote is left in --out-dir), 3 an internal failure.
 #include <CLI/CLI.hpp>
 
 #include <string>
@@ -19,8 +20,9 @@ struct CrosscheckOptions {
   unsigned width = 0, height = 0;  // 0: the scene file's film, else 64 x 48
   unsigned spp = 64;
   unsigned mitsuba_spp_factor = 4;
-  int bounces = -2;  // -2: the scene file's max_depth, else 2
-  unsigned threads = 0;
+  int bounces = -2;  // given only when bounces_option->count(); else the scene file's max_depth, else 2
+  CLI::Option* bounces_option = nullptr;
+  int threads = 0;
   bool strict = false;
 };
 

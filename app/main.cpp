@@ -12,6 +12,7 @@
 #include "compare_command.h"
 #include "crosscheck_command.h"
 #include "history_command.h"
+#include "pathbench/common/display_text.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/output_file.h"
 #include "pathbench/run/world.h"
@@ -64,7 +65,7 @@ int main(int argc, char** argv) {
     // two lines without it). Multi-line messages are joined.
     std::string message = e.what();
     std::replace(message.begin(), message.end(), '\n', ' ');
-    fmt::print(stderr, "pathbench: error: {}\n", message);
+    fmt::print(stderr, "pathbench: error: {}\n", pb::terminal_safe(message));
     return pb::kExitBadInput;
   }
   // From here on output files are being written: a fatal signal removes their
@@ -83,10 +84,10 @@ int main(int argc, char** argv) {
   } catch (const pb::run::PeerFailure& e) {
     return e.code;  // another rank failed; rank 0 printed its message
   } catch (const pb::InputError& e) {
-    fmt::print(stderr, "pathbench: error: {}\n", e.what());
+    fmt::print(stderr, "pathbench: error: {}\n", pb::terminal_safe(e.what()));  // names in it are data
     return pb::kExitBadInput;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "pathbench: failed: {}\n", e.what());
+    fmt::print(stderr, "pathbench: failed: {}\n", pb::terminal_safe(e.what()));
     return pb::kExitFailed;
   }
   return 0;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_checks.h"
+#include "pathbench/common/display_text.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/report.h"
@@ -70,6 +71,8 @@ void add_render_options(CLI::App& cmd, RenderOptions& o) {
   cmd.add_option("--report", o.report, "run report (.json)");
   cmd.add_flag("--profile", o.profile, "print a per-stage GPU profile");
   cmd.add_flag("--quiet", o.quiet, "no progress bar and no summary");
+  cmd.footer("Exit status: 0 rendered and written, 2 bad input (a scene or option pathbench refuses, a size past "
+             "its limit, an output path it cannot write; one message, nothing written), 3 an internal failure.");
 }
 
 void finish_render_options(RenderOptions& o) {
@@ -118,7 +121,8 @@ void apply_scene_defaults(const Scene& scene, RenderOptions& o) {
     take(d.max_bounces < 0 ? std::string("unbounded path length") : fmt::format("{} bounces", d.max_bounces));
   }
   if (!taken.empty())
-    fmt::print(stderr, "note: {}: {} from the scene file (options on the command line override them)\n", scene.name, taken);
+    fmt::print(stderr, "note: {}: {} from the scene file (options on the command line override them)\n",
+               terminal_safe(scene.name), taken);
 }
 
 // What an image must say about where it came from (EXR attributes, PNG text).
@@ -178,7 +182,7 @@ int run_render(RenderOptions& o) {
   commit_all(outputs);
   if (!o.quiet) {
     fmt::print("{} {}x{} {} spp, {} bounces, {} sampling, {}, {}/{}: {:.3f} s, {:.2f} M rays/s ({} rays, {} paths",
-               scene.name, o.settings.width, o.settings.height, o.settings.spp,
+               terminal_safe(scene.name), o.settings.width, o.settings.height, o.settings.spp,
                o.settings.max_bounces < 0 ? std::string("unbounded") : std::to_string(o.settings.max_bounces),
                to_string(o.settings.sampling), to_string(o.settings.precision), to_string(o.settings.device),
                to_string(o.settings.strategy),
@@ -195,8 +199,8 @@ int run_render(RenderOptions& o) {
                  x["count"].get<int>(), x["balance"].get<std::string>(), share, x["load_balance"].get<double>(),
                  x["parallel_efficiency"].get<double>(), x["reduce_seconds"].get<double>());
     }
-    if (!o.out.empty()) fmt::print("image: {}\n", o.out);
-    if (!o.report.empty()) fmt::print("report: {}\n", o.report);
+    if (!o.out.empty()) fmt::print("image: {}\n", terminal_safe(o.out));
+    if (!o.report.empty()) fmt::print("report: {}\n", terminal_safe(o.report));
   }
   return 0;
 }

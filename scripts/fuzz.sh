@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target for a bounded time and fails on any finding: a crash, a
 # sanitizer report (ASan + UBSan), a leak, a slow input (> 10 s) or one over 2 GB.
-#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | off | history | all
+#   scripts/fuzz.sh TARGET SECONDS     TARGET: scene_json | obj | bench_json | ply | gltf | mitsuba | off | compare_context | history | all
 # (history: the Python history's readers, tests/fuzz/python/fuzz_history.py under atheris)
 # Builds build-fuzz/ with clang first (-DPATHBENCH_FUZZ=ON). The seed corpus is
 # tests/fuzz/corpus/TARGET (read only); what the fuzzer learns goes to
@@ -11,8 +11,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
-targets="scene_json obj bench_json ply gltf mitsuba off history"
-target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|off|history|all SECONDS}
+targets="scene_json obj bench_json ply gltf mitsuba off compare_context history"
+target=${1:?usage: scripts/fuzz.sh scene_json|obj|bench_json|ply|gltf|mitsuba|off|compare_context|history|all SECONDS}
 seconds=${2:?usage: scripts/fuzz.sh TARGET SECONDS}
 build=${PATHBENCH_FUZZ_BUILD:-build-fuzz}
 
@@ -37,7 +37,7 @@ if [ "$target" = history ]; then  # Python, no build: atheris, else a seeded mut
   exit 0
 fi
 case "$target" in
-  scene_json|bench_json) dict=tests/fuzz/json.dict ;;
+  scene_json|bench_json|compare_context) dict=tests/fuzz/json.dict ;;
   gltf) dict=tests/fuzz/gltf.dict ;;
   obj) dict=tests/fuzz/obj.dict ;;
   ply) dict=tests/fuzz/ply.dict ;;

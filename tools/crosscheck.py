@@ -21,6 +21,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -63,15 +64,127 @@ def compare(ours, var_ours, ref, var_ref, mean_tolerance):
     return summary, np.where(exact, np.where(passed, 0.0, np.inf), np.abs(z)).astype(np.float32)
 
 
-def render_mitsuba(xml: Path, variant: str, spp: int, passes: int):
+class BadInput(Exception):
+    """Input this tool cannot judge: one line for the user, exit status 2."""
+
+
+def shown(text) -> str:
+    """`text` for a terminal: control characters, C1 controls and invisible reordering
+    code points escaped (a file name or a Mitsuba message is data, not terminal input)."""
+    out = []
+    for c in str(text):
+        o = ord(c)
+        if o < 0x20 or o == 0x7F or 0x80 <= o <= 0x9F or o in INVISIBLE:
+            out.append({"\n": "\\n", "\r": "\\r", "\t": "\\t", "\x1b": "\\e"}.get(
+                c, f"\\x{o:02x}" if o < 0x80 else f"\\u{{{o:x}}}"))
+        elif 0xD800 <= o <= 0xDFFF:  # a byte that was not UTF-8 (surrogateescape)
+            out.append(f"\\x{o - 0xDC00:02x}" if o >= 0xDC80 else f"\\u{{{o:x}}}")
+        else:
+            out.append(c)
+    return "".join(out)
+
+
+INVISIBLE = {0x061C, 0x200E, 0x200F, 0x2028, 0x2029, 0xFEFF, *range(0x202A, 0x202F), *range(0x2066, 0x206A)}
+MAX_SPP = 2**32 - 1       # Mitsuba's sample count is a 32-bit unsigned integer
+MAX_PASSES = 4096
+DEVICE = re.compile(r"[a-z0-9_]{1,32}")  # names a file (diff-DEVICE.pfm): no path in it
+
+
+def pathbench_integrator(bounces: int) -> dict:
+    """What `pathbench render` renders a scene without an <integrator> with: --bounces N
+    and light sampling + MIS is Mitsuba's `path` with max_depth N + 1 and no Russian
+    roulette; unbounded (-1) is max_depth -1, ended by Russian roulette."""
+    if bounces < 0:
+        return {"type": "path", "max_depth": -1, "hide_emitters": False}
+    return {"type": "path", "max_depth": bounces + 1, "rr_depth": bounces + 101, "hide_emitters": False}
+
+
+def rgb(image: np.ndarray) -> np.ndarray:
+    """Mitsuba's film as (height, width, 3): luminance repeated, alpha and AOVs dropped."""
+    a = np.asarray(image, dtype=np.float32)
+    if a.ndim == 2:
+        a = a[:, :, None]
+    if a.ndim != 3 or a.shape[2] == 0:
+        raise BadInput(f"Mitsuba's film has shape {a.shape}, not an image")
+    return np.repeat(a[:, :, :1], 3, axis=2) if a.shape[2] < 3 else a[:, :, :3]
+
+
+def render_mitsuba(xml: Path, variant: str, spp: int, passes: int, bounces: int = 2):
     mi = ms.import_mitsuba(variant)
-    scene = mi.load_file(str(xml))
-    each = max(1, spp // passes)
-    images = np.stack([np.array(mi.render(scene, spp=each, seed=i))[:, :, :3] for i in range(passes)])
+    try:
+        scene = mi.load_file(str(xml))
+        # A scene without an <integrator> renders in pathbench (its defaults); Mitsuba's
+        # render() refuses one, so it gets pathbench's estimator.
+        integrator = scene.integrator() or mi.load_dict(pathbench_integrator(bounces))
+        each = max(1, spp // passes)
+        images = np.stack([rgb(mi.render(scene, integrator=integrator, spp=each, seed=i)) for i in range(passes)])
+    except BadInput:
+        raise
+    except Exception as e:  # Mitsuba's parser and plugins: the message names the file and what is wrong
+        raise BadInput(f"Mitsuba cannot render {xml}: {str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__}") from None
     return images.mean(0), images.var(0, ddof=1) / passes, each * passes
 
 
-def main(argv=None) -> int:
+def check_arguments(a) -> None:
+    if not a.image:
+        raise BadInput("no --image given")
+    if not 1 <= a.spp <= MAX_SPP:
+        raise BadInput(f"--spp {a.spp}: must be 1 to {MAX_SPP} (Mitsuba's sample count is 32 bits)")
+    if not 2 <= a.passes <= MAX_PASSES:
+        raise BadInput(f"--passes {a.passes}: must be 2 to {MAX_PASSES}")
+    if not (math.isfinite(a.mean_tolerance) and a.mean_tolerance >= 0):
+        raise BadInput(f"--mean-tolerance {a.mean_tolerance}: must be a finite number >= 0")
+    if a.out_dir.exists() and not a.out_dir.is_dir():
+        raise BadInput(f"--out-dir {a.out_dir}: is a file, not a directory")
+
+
+def read_images(specs):
+    images = {}
+    for spec in specs:
+        device, sep, path = spec.partition("=")
+        if not sep or not DEVICE.fullmatch(device):
+            raise BadInput(f"--image {spec}: expected DEVICE=FILE.pfm, DEVICE of a-z, 0-9 and _")
+        if device in images:
+            raise BadInput(f"--image {spec}: device {device} given twice")
+        p = Path(path)
+        var = p.with_name(p.stem + "-var.pfm")
+        try:
+            images[device] = (ms.read_pfm(p), ms.read_pfm(var))
+        except (OSError, ValueError) as e:
+            raise BadInput(f"{p}: {e}") from None
+        if images[device][0].shape != images[device][1].shape:
+            raise BadInput(f"{var}: {images[device][1].shape[1]}x{images[device][1].shape[0]}, its image "
+                           f"{images[device][0].shape[1]}x{images[device][0].shape[0]}")
+    return images
+
+
+def write_outputs(out_dir: Path, files: dict, verdict: dict) -> None:
+    """All of a run's files, or (on any failure) none of them: what this call created,
+    the folders included, is removed again before the error goes on."""
+    created = [p for p in [out_dir, *out_dir.parents] if not p.exists()]
+    written = []
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for name, image in files.items():
+            written.append(out_dir / name)
+            ms.write_pfm(out_dir / name, image)
+        written.append(out_dir / "verdict.json")
+        tmp = out_dir / "verdict.json.tmp"
+        tmp.write_text(json.dumps(verdict, indent=2) + "\n")
+        tmp.replace(out_dir / "verdict.json")
+    except OSError as e:
+        for p in written:
+            for q in (p, p.with_name(p.name + ".tmp")):
+                q.unlink(missing_ok=True)
+        for d in created:  # innermost first
+            try:
+                d.rmdir()
+            except OSError:
+                pass
+        raise BadInput(f"--out-dir {out_dir}: {e.strerror or e}") from None
+
+
+def run(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--xml", type=Path, required=True, help="the Mitsuba 3 scene")
     ap.add_argument("--image", action="append", default=[], metavar="DEVICE=FILE.pfm",
@@ -79,62 +192,63 @@ def main(argv=None) -> int:
     ap.add_argument("--spp", type=int, default=256, help="Mitsuba's samples per pixel in all")
     ap.add_argument("--pathbench-spp", type=int, default=0, help="for the record")
     ap.add_argument("--passes", type=int, default=16, help="independent Mitsuba renders (variance)")
+    ap.add_argument("--bounces", type=int, default=2,
+                    help="pathbench's bounces, for a scene without an <integrator> (-1: unbounded)")
     ap.add_argument("--variant", default="scalar_rgb")
     ap.add_argument("--mean-tolerance", type=float, default=0.02, help="per-channel image mean, relative")
     ap.add_argument("--scene", default="", help="for the record")
     ap.add_argument("--out-dir", type=Path, required=True)
     a = ap.parse_args(argv)
-    if not a.image:
-        print("crosscheck.py: error: no --image given", file=sys.stderr)
-        return 2
-    if a.passes < 2:
-        print("crosscheck.py: error: --passes must be at least 2", file=sys.stderr)
-        return 2
-    images = {}
-    for spec in a.image:
-        device, _, path = spec.partition("=")
-        p = Path(path)
-        var = p.with_name(p.stem + "-var.pfm")
-        try:
-            images[device] = (ms.read_pfm(p), ms.read_pfm(var))
-        except (OSError, ValueError) as e:
-            print(f"crosscheck.py: error: {p}: {e}", file=sys.stderr)
-            return 2
+    check_arguments(a)
+    images = read_images(a.image)
     try:
-        ref, var_ref, spp = render_mitsuba(a.xml, a.variant, a.spp, a.passes)
+        ref, var_ref, spp = render_mitsuba(a.xml, a.variant, a.spp, a.passes, a.bounces)
     except ModuleNotFoundError as e:
-        print(f"crosscheck.py: error: Mitsuba 3 is not installed ({e}); scripts/install-deps.sh installs it",
-              file=sys.stderr)
-        return 2
-    except ImportError as e:  # installed, but it failed to load (seen: another Embree first on LD_LIBRARY_PATH)
-        print(f"crosscheck.py: error: Mitsuba 3 is installed but failed to load ({e}); a library it needs may be "
-              f"missing or shadowed (LD_LIBRARY_PATH={os.environ.get('LD_LIBRARY_PATH', '')!r})", file=sys.stderr)
-        return 2
-    except RuntimeError as e:  # Mitsuba's parser: the message names the file and line
-        print(f"crosscheck.py: error: Mitsuba cannot load {a.xml}: {e}", file=sys.stderr)
-        return 2
-    a.out_dir.mkdir(parents=True, exist_ok=True)
-    ms.write_pfm(a.out_dir / "mitsuba.pfm", ref.astype(np.float32))
+        raise BadInput(f"Mitsuba 3 is not installed ({e}); scripts/install-deps.sh installs it") from None
+    except ImportError as e:
+        if "unsupported variant" in str(e):
+            raise BadInput(f"--variant {a.variant}: not a variant this Mitsuba has") from None
+        # Installed, but it failed to load (seen: another Embree first on LD_LIBRARY_PATH).
+        raise BadInput(f"Mitsuba 3 is installed but failed to load ({e}); a library it needs may be missing or "
+                       f"shadowed (LD_LIBRARY_PATH={os.environ.get('LD_LIBRARY_PATH', '')!r})") from None
     verdict = {"scene": a.scene, "mitsuba_xml": str(a.xml), "mitsuba_spp": spp, "pathbench_spp": a.pathbench_spp,
                "variant": a.variant, "devices": {}}
+    files = {"mitsuba.pfm": ref.astype(np.float32)}
+    lines = []
     ok = True
     for device, (ours, var_ours) in images.items():
         if ours.shape != ref.shape:
-            print(f"crosscheck.py: error: pathbench's {device} image is {ours.shape[1]}x{ours.shape[0]}, Mitsuba's "
-                  f"{ref.shape[1]}x{ref.shape[0]} (give the film's size)", file=sys.stderr)
-            return 2
+            raise BadInput(f"pathbench's {device} image is {ours.shape[1]}x{ours.shape[0]}, Mitsuba's "
+                           f"{ref.shape[1]}x{ref.shape[0]} (give the film's size)")
         summary, zimg = compare(ours, var_ours, ref, var_ref, a.mean_tolerance)
-        ms.write_pfm(a.out_dir / f"diff-{device}.pfm", np.abs(ours - ref).astype(np.float32))
-        ms.write_pfm(a.out_dir / f"z-{device}.pfm", np.minimum(zimg, 1e30))
+        files[f"diff-{device}.pfm"] = np.abs(ours - ref).astype(np.float32)
+        files[f"z-{device}.pfm"] = np.minimum(zimg, 1e30)
         verdict["devices"][device] = summary
         ok &= summary["pass"]
         r = summary["mean_ratio"]
-        print(f"crosscheck: {device}: {'PASS' if summary['pass'] else 'FAIL'}: {100 * summary['share_passed']:.2f} % of "
-              f"{summary['values']} pixel-channels pass (need {100 * MIN_SHARE:.0f} %); image mean / Mitsuba's: "
-              f"R {r[0]:.4f} G {r[1]:.4f} B {r[2]:.4f} (within {a.mean_tolerance:g})")
-    (a.out_dir / "verdict.json").write_text(json.dumps(verdict, indent=2) + "\n")
-    print(f"crosscheck: {'same up to noise' if ok else 'DIFFERENT'}; images and verdict.json in {a.out_dir}")
+        lines.append(f"crosscheck: {device}: {'PASS' if summary['pass'] else 'FAIL'}: {100 * summary['share_passed']:.2f} "
+                     f"% of {summary['values']} pixel-channels pass (need {100 * MIN_SHARE:.0f} %); image mean / "
+                     f"Mitsuba's: R {r[0]:.4f} G {r[1]:.4f} B {r[2]:.4f} (within {a.mean_tolerance:g})")
+    write_outputs(a.out_dir, files, verdict)  # only once every check has passed: all of them or none
+    for line in lines:
+        print(line)
+    print(f"crosscheck: {'same up to noise' if ok else 'DIFFERENT'}; images and verdict.json in {shown(a.out_dir)}")
     return 0 if ok else 1
+
+
+def main(argv=None) -> int:
+    """Exit status: 0 every device passes, 1 one does not, 2 bad input (one line on
+    stderr, nothing written), 3 an internal failure (one line, no traceback)."""
+    try:
+        return run(argv)
+    except BadInput as e:
+        print(f"crosscheck.py: error: {shown(e)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    except Exception as e:  # noqa: BLE001 (a bug here: said in one line, never taken for "different")
+        print(f"crosscheck.py: internal error: {type(e).__name__}: {shown(e)}", file=sys.stderr)
+        return 3
 
 
 if __name__ == "__main__":

@@ -58,6 +58,9 @@ MAX_DEPTH = 3  # Mitsuba counts segments: 3 = two diffuse bounces = pathbench --
 
 LLVM_DEFAULT = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
 
+# Largest PFM image read_pfm reads: pathbench's own image limit (limits.h kMaxPixels).
+MAX_PFM_PIXELS = 1 << 28
+
 
 def triangle_count() -> int:
     return sum(len(tris) for _, tris, _, _ in PARTS)
@@ -234,16 +237,30 @@ def read_pfm(path):
     import numpy as np  # noqa: PLC0415
 
     with open(path, "rb") as f:
-        kind = f.readline().strip()
+        kind = f.readline(16).strip()
         if kind not in (b"PF", b"Pf"):
             raise ValueError(f"{path}: not a PFM file")
-        dims = f.readline().split()
+        dims = f.readline(64).split()
         while len(dims) < 2:
-            dims += f.readline().split()
-        w, h = int(dims[0]), int(dims[1])
-        scale = float(f.readline())
+            line = f.readline(64)
+            if not line:
+                raise ValueError(f"{path}: PFM header ends before its width and height")
+            dims += line.split()
+        try:
+            w, h = int(dims[0]), int(dims[1])
+            scale = float(f.readline(64))
+        except ValueError:
+            raise ValueError(f"{path}: malformed PFM header") from None
         ch = 3 if kind == b"PF" else 1
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4", count=w * h * ch)
+        # Sizes from the header are checked before they size anything: a header may claim
+        # any size; the data must hold that many values.
+        if w <= 0 or h <= 0 or w * h > MAX_PFM_PIXELS or not math.isfinite(scale) or scale == 0:
+            raise ValueError(f"{path}: PFM header of {w}x{h} pixels, scale {scale} is not supported (1 to "
+                             f"{MAX_PFM_PIXELS} pixels, a finite nonzero scale)")
+        data = f.read(w * h * ch * 4)
+        if len(data) != w * h * ch * 4:
+            raise ValueError(f"{path}: PFM data is {len(data)} bytes, its header says {w * h * ch * 4}")
+        data = np.frombuffer(data, dtype="<f4" if scale < 0 else ">f4", count=w * h * ch)
     img = data.reshape(h, w, ch)[::-1].astype(np.float32)
     if ch == 1:
         img = np.repeat(img, 3, axis=2)

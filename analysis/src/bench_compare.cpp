@@ -10,11 +10,15 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <numeric>
+#include <optional>
 
 #include "compare_context.h"
+#include "json_fields.h"
+#include "pathbench/common/display_text.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/json_input.h"
@@ -193,53 +197,69 @@ BenchFile load_benchmark_json(const std::string& path, int min_repetitions) {
 }
 
 BenchFile bench_file_from_json(const std::string& path, const nlohmann::json& j, int min_repetitions) try {
-  if (!j.is_object() || !j.contains("benchmarks") || !j["benchmarks"].is_array() || !j.contains("context"))
+  const auto list = j.is_object() ? j.find("benchmarks") : j.end();
+  if (!j.is_object() || list == j.end() || !list->is_array() || !j.contains("context"))
     throw InputError(fmt::format("{}: not Google Benchmark JSON (expected an object with 'context' and a "
                                  "'benchmarks' array; write it with --benchmark_out=FILE.json)",
                                  path));
   BenchFile f;
   f.path = path;
-  f.context = j["context"].is_object() ? j["context"] : nlohmann::json::object();
+  f.context = j.at("context");
+  f.run = read_bench_context(path, f.context);
+  if (!f.context.is_object()) f.context = nlohmann::json::object();
   std::map<std::string, bool> has_aggregates;
-  for (const auto& b : j["benchmarks"]) {
-    if (!b.is_object() || !b.contains("name"))
-      throw InputError(fmt::format("{}: a 'benchmarks' entry has no 'name'", path));
-    const std::string name = b.value("run_name", b["name"].get<std::string>());
+  for (size_t i = 0; i < list->size(); ++i) {
+    const nlohmann::json& b = (*list)[i];
+    const std::string where = fmt::format("benchmarks[{}]", i);
+    if (!b.is_object()) fields::wrong(path, where, "an object", b);
+    const fields::Reader r(path, b, where);
+    const std::optional<std::string> run_name = r.string("run_name"), plain_name = r.string("name");
+    if (!plain_name) throw InputError(fmt::format("{}: {}: missing (every benchmark has a name)", path, r.field("name")));
+    const std::string name = run_name.value_or(*plain_name);
     // The table pads every row to the longest name: a megabyte name times thousands of
     // rows would be gigabytes of output.
     if (name.size() > kMaxBenchmarkName)
-      throw InputError(fmt::format("{}: a benchmark name of {} bytes (at most {})", path, name.size(), kMaxBenchmarkName));
-    const std::string run_type = b.value("run_type", "iteration");
+      throw InputError(fmt::format("{}: {}: a benchmark name of {} bytes (at most {})", path,
+                                   r.field(run_name ? "run_name" : "name"), name.size(), kMaxBenchmarkName));
+    const std::string run_type = r.string_or("run_type", "iteration");
     if (!f.series.count(name)) f.order.push_back(name);
     BenchSeries& s = f.series[name];
-    if (b.value("error_occurred", false)) {
+    if (r.boolean("error_occurred").value_or(false)) {
       s.error = true;
-      s.error_message = b.value("error_message", "error");
+      s.error_message = r.string_or("error_message", "error");
       continue;
     }
     if (run_type == "aggregate") {
       has_aggregates[name] = true;
       continue;
     }
-    if (!b.contains("real_time") || !b["real_time"].is_number() || !b.contains("iterations"))
-      throw InputError(fmt::format("{}: benchmark '{}' has no numeric 'real_time'", path, name));
-    const double scale = unit_to_seconds(b.value("time_unit", "ns"), path, name);
-    s.seconds.push_back(b["real_time"].get<double>() * scale);
-    if (b.contains("rays_per_second") && b["rays_per_second"].is_number())
-      s.rays_per_second.push_back(b["rays_per_second"].get<double>());
-    if (b.contains("process_cpu_seconds") && b["process_cpu_seconds"].is_number()) {
-      s.cpu_seconds.push_back(b["process_cpu_seconds"].get<double>());
+    // Times and counters: any finite number (a negative or zero time is judged "invalid"
+    // by compare_files, not refused here); null is Google Benchmark's NaN: not given.
+    constexpr double kBig = std::numeric_limits<double>::max();
+    const std::optional<double> real_time = r.number("real_time", -kBig, kBig);
+    if (!real_time)
+      throw InputError(fmt::format("{}: {}: missing (benchmark '{}' has no numeric 'real_time')", path,
+                                   r.field("real_time"), name));
+    if (!r.number("iterations", 0, kBig))
+      throw InputError(fmt::format("{}: {}: missing (benchmark '{}')", path, r.field("iterations"), name));
+    const std::string unit = r.string_or("time_unit", "ns");
+    const double scale = unit_to_seconds(unit, path, name);
+    s.seconds.push_back(*real_time * scale);
+    if (const auto rays = r.number("rays_per_second", -kBig, kBig)) s.rays_per_second.push_back(*rays);
+    // Both read (and so type-checked) whichever is used.
+    const auto process = r.number("process_cpu_seconds", -kBig, kBig), cpu = r.number("cpu_time", -kBig, kBig);
+    if (process) {
+      s.cpu_seconds.push_back(*process);
       s.cpu_is_process = true;
-    } else if (b.contains("cpu_time") && b["cpu_time"].is_number()) {
-      s.cpu_seconds.push_back(b["cpu_time"].get<double>() * scale);
+    } else if (cpu) {
+      s.cpu_seconds.push_back(*cpu * scale);
     }
-    if (b.contains("throttled") && b["throttled"].is_number() && b["throttled"].get<double>() > 0) s.throttled = true;
-    if (b.contains("label") && b["label"].is_string() && !b["label"].get<std::string>().empty())
-      s.labels.insert(b["label"].get<std::string>());
+    if (const auto throttled = r.number("throttled", -kBig, kBig); throttled && *throttled > 0) s.throttled = true;
+    if (const auto label = r.string("label"); label && !label->empty()) s.labels.insert(*label);
     // A counter named like Google Benchmark's own "threads" key was a duplicate key in
     // older files; parsing keeps the last, which was the counter.
     for (const char* k : {"cpu_threads", "threads"})
-      if (b.contains(k) && b[k].is_number() && s.cpu_threads < 0) s.cpu_threads = b[k].get<double>();
+      if (const auto t = r.number(k, -kBig, kBig); t && s.cpu_threads < 0) s.cpu_threads = *t;
   }
   if (f.series.empty()) throw InputError(fmt::format("{}: the file lists no benchmarks", path));
   for (const auto& name : f.order) {
@@ -376,13 +396,16 @@ int run_compare(const CompareOptions& o) {
                                  o.base, o.next));
   describe_runs(base, next, rep);
   if (o.strict && !rep.warnings.empty()) {
-    for (const auto& w : rep.warnings) fmt::print(stderr, "warning: {}\n", w);
+    for (const auto& w : rep.warnings) fmt::print(stderr, "warning: {}\n", terminal_safe(w));
     throw InputError(fmt::format("--strict: the runs differ ({} warning(s) above); not comparing",
                                  rep.warnings.size()));
   }
   const bool any = count_verdict(rep.rows, Verdict::Regressed) > 0;
   if (o.format == "json") {
-    fmt::print("{}\n", format_json(rep).dump(2));
+    // ASCII with \u escapes: a name's C1 controls or bidirectional overrides are not
+    // written raw to a terminal either. Strings from the files are UTF-8 (the parser
+    // checks); a path from the command line may not be: U+FFFD then, not a failure.
+    fmt::print("{}\n", format_json(rep).dump(2, ' ', true, nlohmann::json::error_handler_t::replace));
   } else if (o.format == "markdown") {
     fmt::print("{}", format_markdown(rep));
   } else {

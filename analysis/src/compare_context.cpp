@@ -2,9 +2,14 @@
 
 #include <fmt/core.h>
 
+#include <optional>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
+
+#include "json_fields.h"
+#include "pathbench/common/display_text.h"
 
 namespace pb::analysis {
 
@@ -31,10 +36,10 @@ std::vector<std::string> differences(const Json& a, const Json& b, size_t limit 
   for (const auto& [k, v] : fa) {
     auto it = fb.find(k);
     const std::string w = it == fb.end() ? "(none)" : it->second;
-    if (v != w) out.push_back(fmt::format("{}: {} -> {}", k, v, w));
+    if (v != w) out.push_back(fmt::format("{}: {} -> {}", clip_text(k), clip_text(v), clip_text(w)));
   }
   for (const auto& [k, v] : fb)
-    if (!fa.count(k)) out.push_back(fmt::format("{}: (none) -> {}", k, v));
+    if (!fa.count(k)) out.push_back(fmt::format("{}: (none) -> {}", clip_text(k), clip_text(v)));
   if (out.size() > limit) {
     const size_t more = out.size() - limit;
     out.resize(limit);
@@ -43,64 +48,105 @@ std::vector<std::string> differences(const Json& a, const Json& b, size_t limit 
   return out;
 }
 
-std::string joined(const std::vector<std::string>& v) {
+// The first `limit` items, each clipped, joined with "; " (then "... N more").
+std::string joined(const std::vector<std::string>& v, size_t limit = 8) {
   std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : "; ") + x;
+  for (size_t i = 0; i < v.size() && i < limit; ++i) s += (s.empty() ? "" : "; ") + clip_text(v[i], 320);
+  if (v.size() > limit) s += fmt::format("; ... {} more", v.size() - limit);
   return s;
-}
-
-const Json* fingerprint_of(const BenchFile& f) {
-  auto it = f.context.find("fingerprint");
-  return it != f.context.end() && it->is_object() ? &*it : nullptr;
 }
 
 Json pick(const Json& j, std::initializer_list<const char*> keys) {
   Json out = Json::object();
   for (const char* k : keys)
-    if (j.contains(k)) out[k] = j[k];
+    if (const auto it = j.find(k); it != j.end()) out[k] = *it;
   return out;
 }
 
-// Google Benchmark's context with its caches array as {"L1d": bytes, ...}, so that a
-// difference reads "caches.L2: 524288 -> 1048576".
-Json gb_machine(const Json& context) {
-  Json out = pick(context, {"cpu_model", "num_cpus", "mhz_per_cpu"});
-  if (context.contains("caches") && context["caches"].is_array()) {
-    Json caches = Json::object();
-    for (const auto& c : context["caches"]) {
-      const std::string type = c.value("type", std::string());
-      caches[fmt::format("L{}{}", c.value("level", 0), type == "Data" ? "d" : type == "Instruction" ? "i" : "")] =
-          c.value("size", Json(nullptr));
-    }
-    out["caches"] = caches;
+// Google Benchmark's caches array as {"L1d": bytes, ...}, so that a difference reads
+// "caches.L2: 524288 -> 1048576".
+Json gb_caches(const fields::Reader& c) {
+  const Json* caches = c.array("caches");
+  if (!caches) return nullptr;
+  Json out = Json::object();
+  for (size_t i = 0; i < caches->size(); ++i) {
+    const std::string name = fmt::format("{}[{}]", c.field("caches"), i);
+    const Json& entry = (*caches)[i];
+    if (!entry.is_object()) fields::wrong(c.path(), name, "an object", entry);
+    const fields::Reader e = c.sub(entry, name);
+    const std::string type = e.string_or("type", "");
+    const int level = int(e.number("level", 0, 16, true).value_or(0));
+    const Json* size = fields::member(entry, "size");
+    out[fmt::format("L{}{}", level, type == "Data" ? "d" : type == "Instruction" ? "i" : "")] = size ? *size : Json();
   }
   return out;
 }
 
+}  // namespace
+
+BenchContext read_bench_context(const std::string& path, const Json& context) {
+  BenchContext r;
+  if (context.is_null()) return r;
+  if (!context.is_object()) fields::wrong(path, "context", "an object", context);
+  const fields::Reader c(path, context, "context");
+  r.git_revision = c.string_or("git_revision", "unknown");
+  r.date = c.string("date_utc").value_or(c.string_or("date", "?"));
+  r.machine = c.string_or("machine", "?");
+  if (const Json* fp = c.object("fingerprint")) {
+    const fields::Reader f = c.sub(*fp, c.field("fingerprint"));
+    const std::optional<std::string> id = f.string("machine_id");
+    if (!id || id->empty())
+      throw InputError(fmt::format("{}: {}: missing or empty (a machine fingerprint names its machine)", path,
+                                   f.field("machine_id")));
+    r.has_fingerprint = true;
+    r.machine_id = *id;
+    r.identity = pick(*fp, {"cpu", "memory_gib"});
+    r.build = pick(*fp, {"build", "libraries"});
+    if (const Json* gpu = f.object("gpu")) {
+      const fields::Reader g = f.sub(*gpu, f.field("gpu"));
+      if (const auto gid = g.string("gpu_id")) r.gpu_id = *gid;
+      r.gpu_name = g.string("name").value_or(g.string_or("none", "none"));
+    }
+  }
+  r.gb_machine = pick(context, {"cpu_model", "num_cpus", "mhz_per_cpu"});
+  if (Json caches = gb_caches(c); !caches.is_null()) r.gb_machine["caches"] = std::move(caches);
+  r.gb_build = pick(context, {"compiler", "cxx_flags", "build_type", "embree_version"});
+  r.settings = pick(context, {"pathbench_preset", "cpu_tbb_threads"});
+  // 1 to 2^24 CPUs; loads and CPU shares up to 2^40 (anything larger is not a measurement).
+  r.num_cpus = c.number("num_cpus", 1, double(1 << 24), true).value_or(-1);
+  if (const Json* load = c.array("load_avg")) {
+    r.load_avg = *load;
+    for (size_t i = 0; i < load->size(); ++i)
+      if (!(*load)[i].is_null()) c.number_value((*load)[i], fmt::format("{}[{}]", c.field("load_avg"), i), 0, 0x1p40);
+    if (!load->empty() && !load->front().is_null()) r.load1 = load->front().get<double>();
+  }
+  if (const Json* run = c.object("run"))
+    r.cpu_per_wall = c.sub(*run, c.field("run")).number("cpu_per_wall", 0, 0x1p40).value_or(-1);
+  return r;
+}
+
+namespace {
+
 Json run_summary(const BenchFile& f) {
-  const Json* fp = fingerprint_of(f);
-  const Json& c = f.context;
+  const BenchContext& c = f.run;
   return {{"path", f.path},
-          {"git_revision", c.value("git_revision", std::string("unknown"))},
-          {"date", c.value("date_utc", c.value("date", std::string("?")))},
-          {"machine", c.value("machine", std::string("?"))},
-          {"machine_id", fp ? (*fp)["machine_id"] : Json(nullptr)},
-          {"load_average_at_start", c.contains("load_avg") ? c["load_avg"] : Json(nullptr)},
-          {"cpu_per_wall", c.contains("run") ? c["run"].value("cpu_per_wall", Json(nullptr)) : Json(nullptr)}};
+          {"git_revision", c.git_revision},
+          {"date", c.date},
+          {"machine", c.machine},
+          {"machine_id", c.has_fingerprint ? Json(c.machine_id) : Json(nullptr)},
+          {"load_average_at_start", c.load_avg},
+          {"cpu_per_wall", c.cpu_per_wall >= 0 ? Json(c.cpu_per_wall) : Json(nullptr)}};
 }
 
 void check_machine(const BenchFile& a, const BenchFile& b, CompareReport& rep) {
-  const Json *fa = fingerprint_of(a), *fb = fingerprint_of(b);
-  if (fa && fb) {
-    if ((*fa)["machine_id"] != (*fb)["machine_id"])
-      rep.warnings.push_back(fmt::format(
-          "different machine: machine_id {} -> {} ({})", (*fa)["machine_id"].dump(), (*fb)["machine_id"].dump(),
-          joined(differences(pick(*fa, {"cpu", "memory_gib"}), pick(*fb, {"cpu", "memory_gib"})))));
-    const Json ga = fa->value("gpu", Json::object()), gb = fb->value("gpu", Json::object());
-    if (ga.value("gpu_id", Json(nullptr)) != gb.value("gpu_id", Json(nullptr)))
-      rep.warnings.push_back(fmt::format("different GPU: {} -> {}", ga.value("name", ga.value("none", std::string("none"))),
-                                         gb.value("name", gb.value("none", std::string("none")))));
-    const auto build = differences(pick(*fa, {"build", "libraries"}), pick(*fb, {"build", "libraries"}));
+  const BenchContext &ca = a.run, &cb = b.run;
+  if (ca.has_fingerprint && cb.has_fingerprint) {
+    if (ca.machine_id != cb.machine_id)
+      rep.warnings.push_back(fmt::format("different machine: machine_id {} -> {} ({})", clip_text(ca.machine_id),
+                                         clip_text(cb.machine_id),
+                                         joined(differences(ca.identity, cb.identity))));
+    if (ca.gpu_id != cb.gpu_id) rep.warnings.push_back(fmt::format("different GPU: {} -> {}", clip_text(ca.gpu_name), clip_text(cb.gpu_name)));
+    const auto build = differences(ca.build, cb.build);
     std::vector<std::string> real;  // the revision differing is the point of comparing
     for (const auto& d : build)
       if (d.rfind("build.git_revision", 0) != 0 && d.rfind("build.source_commit", 0) != 0) real.push_back(d);
@@ -108,20 +154,18 @@ void check_machine(const BenchFile& a, const BenchFile& b, CompareReport& rep) {
     return;
   }
   for (const BenchFile* f : {&a, &b})
-    if (!fingerprint_of(*f))
+    if (!f->run.has_fingerprint)
       rep.notes.push_back(fmt::format("{} has no machine fingerprint (written before pathbench had one): the machine "
                                       "is judged by Google Benchmark's CPU facts only",
                                       f->path));
-  const auto cpu = differences(gb_machine(a.context), gb_machine(b.context));
+  const auto cpu = differences(ca.gb_machine, cb.gb_machine);
   if (!cpu.empty()) rep.warnings.push_back("different machine: " + joined(cpu));
-  const auto build = differences(pick(a.context, {"compiler", "cxx_flags", "build_type", "embree_version"}),
-                                 pick(b.context, {"compiler", "cxx_flags", "build_type", "embree_version"}));
+  const auto build = differences(ca.gb_build, cb.gb_build);
   if (!build.empty()) rep.warnings.push_back("different build: " + joined(build));
 }
 
 void check_settings(const BenchFile& a, const BenchFile& b, CompareReport& rep) {
-  std::vector<std::string> d = differences(pick(a.context, {"pathbench_preset", "cpu_tbb_threads"}),
-                                           pick(b.context, {"pathbench_preset", "cpu_tbb_threads"}));
+  std::vector<std::string> d = differences(a.run.settings, b.run.settings);
   std::vector<std::string> layouts;
   int unlabelled = 0;
   for (const auto& name : a.order) {
@@ -150,12 +194,8 @@ void check_settings(const BenchFile& a, const BenchFile& b, CompareReport& rep) 
 // Load: the 1-minute load average at the start (Google Benchmark's load_avg), and the
 // run's process CPU time over wall time where the file has it (context.run).
 void check_load(const BenchFile& a, const BenchFile& b, CompareReport& rep) {
-  auto load1 = [](const BenchFile& f) {
-    const Json& l = f.context.value("load_avg", Json::array());
-    return l.is_array() && !l.empty() && l[0].is_number() ? l[0].get<double>() : -1.0;
-  };
-  const double la = load1(a), lb = load1(b);
-  const double cpus = std::max(1.0, double(b.context.value("num_cpus", a.context.value("num_cpus", 1))));
+  const double la = a.run.load1, lb = b.run.load1;
+  const double cpus = std::max(1.0, b.run.num_cpus >= 0 ? b.run.num_cpus : a.run.num_cpus);
   if (la >= 0 && lb >= 0) {
     if (std::fabs(la - lb) > std::max(0.5, 0.25 * cpus))
       rep.warnings.push_back(fmt::format("different load: 1-minute load average at the start {:.2f} -> {:.2f} on {} "
@@ -165,12 +205,7 @@ void check_load(const BenchFile& a, const BenchFile& b, CompareReport& rep) {
       rep.notes.push_back(fmt::format("both runs started on a busy machine (load {:.2f} and {:.2f} on {} CPUs)", la,
                                       lb, cpus));
   }
-  auto cpw = [](const BenchFile& f) {
-    return f.context.contains("run") && f.context["run"].value("cpu_per_wall", Json(nullptr)).is_number()
-               ? f.context["run"]["cpu_per_wall"].get<double>()
-               : -1.0;
-  };
-  const double ca = cpw(a), cb = cpw(b);
+  const double ca = a.run.cpu_per_wall, cb = b.run.cpu_per_wall;
   if (ca > 0 && cb > 0 && std::fabs(cb / ca - 1) > 0.2)
     rep.warnings.push_back(fmt::format("different CPU share: the process used {:.2f} -> {:.2f} CPU seconds per wall "
                                        "second over the whole run",

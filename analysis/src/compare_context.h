@@ -8,6 +8,10 @@
 
 namespace pb::analysis {
 
+// What compare reads of a file's "context" (null: none), every field's type checked;
+// throws InputError naming `path` and the field ("context.fingerprint.machine_id: ...").
+BenchContext read_bench_context(const std::string& path, const nlohmann::json& context);
+
 // Fills rep.base_run / new_run, rep.warnings and rep.notes.
 void describe_runs(const BenchFile& base, const BenchFile& next, CompareReport& rep);
 

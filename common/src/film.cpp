@@ -1,11 +1,14 @@
 #include "pathbench/common/film.h"
 
+#include "pathbench/common/settings.h"
+
 #include <atomic>
 #include <cmath>
 
 namespace pb {
 
 Film::Film(uint32_t width, uint32_t height, bool variance) : width_(width), height_(height) {
+  if (width && height) check_image_size(width, height, variance);  // an impossible size is bad input, not bad_alloc
   sum_.assign(pixels() * 3, 0);
   count_.assign(pixels(), 0);
   if (variance) sum_sq_.assign(pixels() * 3, 0.0);

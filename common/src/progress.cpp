@@ -1,5 +1,7 @@
 #include "pathbench/common/progress.h"
 
+#include "pathbench/common/display_text.h"
+
 #include <fmt/core.h>
 #include <unistd.h>
 
@@ -8,7 +10,8 @@
 namespace pb {
 
 Progress::Progress(std::string label, uint64_t total, bool enabled)
-    : label_(std::move(label)), total_(total ? total : 1), enabled_(enabled), tty_(isatty(STDERR_FILENO)) {
+    : label_(terminal_safe(label)),  // the label names the scene: data
+      total_(total ? total : 1), enabled_(enabled), tty_(isatty(STDERR_FILENO)) {
   start_ = std::chrono::steady_clock::now();
   if (enabled_) thread_ = std::thread([this] { run(); });
 }

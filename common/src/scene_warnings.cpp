@@ -2,6 +2,8 @@
 
 #include <fmt/core.h>
 
+#include "pathbench/common/display_text.h"
+
 namespace pb {
 
 namespace {
@@ -13,7 +15,7 @@ void scene_message(SceneMessage kind, const std::string& text) {
     t_collector->messages_.push_back({kind, text});
     return;
   }
-  fmt::print(stderr, "{}: {}\n", kind == SceneMessage::Warning ? "warning" : "note", text);
+  fmt::print(stderr, "{}: {}\n", kind == SceneMessage::Warning ? "warning" : "note", terminal_safe(text));
 }
 
 SceneWarningCollector::SceneWarningCollector() : outer_(t_collector) { t_collector = this; }

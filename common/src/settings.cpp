@@ -1,10 +1,13 @@
 #include "pathbench/common/settings.h"
 
+#include <unistd.h>
+
 #include <stdexcept>
 
 #include <fmt/core.h>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/limits.h"
 
 namespace pb {
 
@@ -112,11 +115,44 @@ void apply_choices(const RenderChoices& c, RenderSettings& s) {
   }
 }
 
+namespace {
+
+// This machine's physical memory in bytes, 0 where it cannot be read.
+uint64_t physical_memory_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) : 0;
+}
+
+}  // namespace
+
+void check_image_size(uint32_t width, uint32_t height, bool variance) {
+  if (width == 0 || height == 0)
+    throw InputError(fmt::format("--width/--height: the image must be at least 1x1 (got {}x{})", width, height));
+  // In 64 bits: a product of two 32-bit factors cannot wrap, nor pixels (at most 2^28,
+  // checked first) times the bytes of a pixel.
+  const uint64_t pixels = uint64_t(width) * height;
+  if (pixels > limits::kMaxPixels)
+    throw InputError(fmt::format("--width/--height: {}x{} is {} pixels, more than the supported {} (16384x16384)",
+                                 width, height, pixels, limits::kMaxPixels));
+  const uint64_t bytes = pixels * (limits::kFilmBytesPerPixel + (variance ? limits::kVarianceBytesPerPixel : 0));
+  if (const uint64_t memory = physical_memory_bytes(); memory > 0 && bytes > memory)
+    throw InputError(fmt::format("--width/--height: the film of {}x{} pixels would take {:.1f} GB, more than this "
+                                 "machine's {:.1f} GB of memory",
+                                 width, height, double(bytes) / 1e9, double(memory) / 1e9));
+}
+
 void RenderSettings::validate() const {
-  if (width == 0 || height == 0) throw InputError(fmt::format("--width/--height: the image must be at least 1x1 (got {}x{})", width, height));
-  if (uint64_t(width) * height > (uint64_t(1) << 31))
-    throw InputError(fmt::format("--width/--height: {}x{} pixels is more than 2^31", width, height));
+  check_image_size(width, height, variance);
   if (spp == 0) throw InputError("--spp: must be at least 1");
+  // In 64 bits: pixels (at most 2^28, checked above) x spp (32 bits) cannot wrap.
+  const uint64_t pixels = uint64_t(width) * height;
+  if (pixels * spp > limits::kMaxFrameSamples)
+    throw InputError(fmt::format("--spp: {}x{} pixels at {} spp is {} samples, more than the supported {} (2^48) in "
+                                 "one frame",
+                                 width, height, spp, pixels * spp, limits::kMaxFrameSamples));
+  if (paths_in_flight > limits::kMaxPathsInFlight)
+    throw InputError(fmt::format("--paths-in-flight: {} is more than the supported {}", paths_in_flight,
+                                 limits::kMaxPathsInFlight));
   if (max_bounces < -1) throw InputError("--bounces: must be >= 0");
   if (max_bounces < 0 && !russian_roulette)
     throw InputError("--converged without Russian roulette would never end a path");

@@ -1,6 +1,7 @@
 # Types of the `pathbench` package (its functions live in the C++ extension _core).
 # tests/python/test_package.py checks that this names every public function, method,
 # property and argument of the built module, with the same defaults.
+import os
 from typing import Literal, overload
 
 import numpy as np
@@ -36,7 +37,7 @@ class Scene:
                  *, backend: Literal["embree", "bvh"] = "embree", watertight: bool = True
                  ) -> npt.NDArray[np.bool_]: ...
 
-def load_scene(name_or_path: str, scale: float = 1.0,
+def load_scene(name_or_path: str | bytes | os.PathLike[str] | os.PathLike[bytes], scale: float = 1.0,
                offset: tuple[float, float, float] | list[float] = (0.0, 0.0, 0.0),
                embree_layout: _Layout = "auto", strict: bool = False) -> Scene: ...
 def builtin_scenes() -> list[tuple[str, str]]: ...

@@ -14,7 +14,46 @@ std::string shape_of(const py::array& a) {
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
+// `a` as a C-contiguous array of T, copied by numpy where it must be. array_t::ensure
+// returns a null array when the copy fails (and clears Python's error): the MemoryError
+// under a memory limit was then used as an array of nothing. numpy's own call raises.
+template <class T>
+py::array_t<T, py::array::c_style | py::array::forcecast> contiguous(const py::handle& a, const char* name) {
+  const py::object converted =
+      py::module_::import("numpy").attr("asarray")(a, py::arg("dtype") = py::dtype::of<T>(), py::arg("order") = "C");
+  auto out = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(converted);
+  if (!out) throw py::type_error(fmt::format("{}: cannot be read as a C-contiguous array", name));
+  return out;
+}
+
 }  // namespace
+
+std::string path_arg(const py::handle& v, const char* name) {
+  if (!py::isinstance<py::str>(v) && !py::isinstance<py::bytes>(v) && !py::hasattr(v, "__fspath__"))
+    throw py::type_error(fmt::format("{} must be a str, bytes or os.PathLike, got {}", name, type_name(v)));
+  return py::module_::import("os").attr("fsencode")(v).cast<std::string>();
+}
+
+py::str text(const std::string& s) {
+  PyObject* o = PyUnicode_DecodeUTF8(s.data(), py::ssize_t(s.size()), "surrogateescape");
+  if (!o) throw py::error_already_set();  // MemoryError: raised, not returned as a null str
+  return py::reinterpret_steal<py::str>(o);
+}
+
+const SceneHandle& scene_arg(const py::handle& v, const char* name) {
+  if (!py::isinstance<SceneHandle>(v))
+    throw py::type_error(fmt::format("{} must be a pathbench.Scene, got {}", name, type_name(v)));
+  std::shared_ptr<SceneHandle> scene;
+  try {
+    scene = v.cast<std::shared_ptr<SceneHandle>>();  // throws for an instance whose holder was never made
+  } catch (const py::cast_error&) {
+  }
+  if (!scene)
+    throw py::value_error(fmt::format("{} is an empty pathbench.Scene (made without pathbench.load_scene, e.g. by "
+                                      "Scene.__new__): load one with pathbench.load_scene",
+                                      name));
+  return *scene;  // held by `v`'s holder as long as `v` lives
+}
 
 FloatArray real_floats(const py::handle& obj, const char* name) {
   // numpy.asarray first, without a dtype, to see what the caller gave: forcecast alone
@@ -33,7 +72,7 @@ FloatArray real_floats(const py::handle& obj, const char* name) {
   if (kind != 'f' && kind != 'i' && kind != 'u')
     throw py::type_error(fmt::format("{} has dtype {}: expected real numbers (float or int)", name,
                                      std::string(py::str(a.dtype()))));
-  return FloatArray::ensure(a);  // float32, C order: copies strided or Fortran-ordered input
+  return contiguous<float>(a, name);  // float32, C order: copies strided or Fortran-ordered input
 }
 
 FloatArray rows3(const py::handle& obj, const char* name) {
@@ -50,7 +89,7 @@ namespace {
 FloatArray traced_origins(const py::handle& obj, Vec3f origin) {
   FloatArray a = rows3(obj, "origins");
   if (origin.x == 0 && origin.y == 0 && origin.z == 0) return a;
-  const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
+  const auto d = contiguous<double>(obj, "origins");
   FloatArray out(std::vector<py::ssize_t>{a.shape(0), 3});
   float* o = out.mutable_data();
   for (py::ssize_t i = 0; i < a.shape(0); ++i)
@@ -82,10 +121,22 @@ Batch make_batch(const py::handle& origins, const py::handle& directions, const 
   return b;
 }
 
+namespace {
+
+// operator.index(v); its exception (an __index__ that raises or returns a non-int)
+// raised, not a null int used.
+py::int_ index_of(const py::handle& v) {
+  PyObject* i = PyNumber_Index(v.ptr());
+  if (!i) throw py::error_already_set();
+  return py::reinterpret_steal<py::int_>(i);
+}
+
+}  // namespace
+
 int64_t int_arg(const py::handle& v, const char* name, int64_t lo, int64_t hi) {
   if (PyBool_Check(v.ptr()) || !PyIndex_Check(v.ptr()))
     throw py::type_error(fmt::format("{} must be an int, got {}", name, type_name(v)));
-  const py::int_ i = py::reinterpret_steal<py::int_>(PyNumber_Index(v.ptr()));
+  const py::int_ i = index_of(v);
   int overflow = 0;
   const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
   if (overflow || x < lo || x > hi)
@@ -96,7 +147,7 @@ int64_t int_arg(const py::handle& v, const char* name, int64_t lo, int64_t hi) {
 uint64_t uint64_arg(const py::handle& v, const char* name) {
   if (PyBool_Check(v.ptr()) || !PyIndex_Check(v.ptr()))
     throw py::type_error(fmt::format("{} must be an int, got {}", name, type_name(v)));
-  const py::int_ i = py::reinterpret_steal<py::int_>(PyNumber_Index(v.ptr()));
+  const py::int_ i = index_of(v);
   const unsigned long long x = PyLong_AsUnsignedLongLong(i.ptr());  // refuses negatives and > 2^64 - 1
   if (PyErr_Occurred()) {
     PyErr_Clear();

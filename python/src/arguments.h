@@ -12,13 +12,16 @@
 
 #include "pathbench/common/math.h"
 #include "ray_cast.h"
+#include "scene_handle.h"
 
 namespace pb::python {
 
 namespace py = pybind11;
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
-// Any array-like of real numbers (float or int dtypes) as C-contiguous float32.
+// Any array-like of real numbers (float or int dtypes) as C-contiguous float32. A
+// conversion that fails (no memory for the copy) raises its Python exception
+// (MemoryError); it is never used as an empty array.
 FloatArray real_floats(const py::handle& obj, const char* name);
 // An (N, 3) array of real numbers.
 FloatArray rows3(const py::handle& obj, const char* name);
@@ -40,5 +43,19 @@ int64_t int_arg(const py::handle& v, const char* name, int64_t lo, int64_t hi);
 uint64_t uint64_arg(const py::handle& v, const char* name);  // [0, 2^64 - 1]
 bool bool_arg(const py::handle& v, const char* name);        // True/False or numpy.bool_
 std::string str_arg(const py::handle& v, const char* name);
+// A file name: str (bytes that are not UTF-8 as os.fsdecode's surrogate escapes), bytes or
+// an os.PathLike, as os.fsencode gives it. TypeError otherwise.
+std::string path_arg(const py::handle& v, const char* name);
+
+// A C++ string (a scene name from a file name, a report field) as a Python str: bytes
+// that are not UTF-8 kept as surrogate escapes (os.fsdecode's convention), never a
+// UnicodeDecodeError.
+py::str text(const std::string& s);
+
+// The scene behind a pathbench.Scene argument (`self` too): TypeError when `v` is not a
+// Scene; ValueError when it has no scene, as one made by Scene.__new__(Scene) (or a
+// pickle or copy of one) without load_scene. Never a null handle. The reference lives as
+// long as `v`.
+const SceneHandle& scene_arg(const py::handle& v, const char* name);
 
 }  // namespace pb::python

@@ -60,9 +60,10 @@ void initialise_at_import() {
   (void)pb::builtin_scenes();
 }
 
-py::dict intersect(const SceneHandle& s, const py::handle& origins, const py::handle& directions,
+py::dict intersect(const py::handle& self, const py::handle& origins, const py::handle& directions,
                    const py::handle& tnear, const py::handle& tfar, const py::handle& backend_name,
                    const py::handle& watertight_flag) {
+  const SceneHandle& s = pb::python::scene_arg(self, "self");
   const Batch b = make_batch(origins, directions, tnear, tfar, s.scene().origin);
   const auto be = pb::python::parse_backend(pb::python::str_arg(backend_name, "backend"));
   const bool watertight = pb::python::bool_arg(watertight_flag, "watertight");
@@ -85,9 +86,10 @@ py::dict intersect(const SceneHandle& s, const py::handle& origins, const py::ha
   return out;
 }
 
-py::array_t<bool> occluded(const SceneHandle& s, const py::handle& origins, const py::handle& directions,
+py::array_t<bool> occluded(const py::handle& self, const py::handle& origins, const py::handle& directions,
                            const py::handle& tnear, const py::handle& tfar, const py::handle& backend_name,
                            const py::handle& watertight_flag) {
+  const SceneHandle& s = pb::python::scene_arg(self, "self");
   const Batch b = make_batch(origins, directions, tnear, tfar, s.scene().origin);
   const auto be = pb::python::parse_backend(pb::python::str_arg(backend_name, "backend"));
   const bool watertight = pb::python::bool_arg(watertight_flag, "watertight");
@@ -100,8 +102,12 @@ py::array_t<bool> occluded(const SceneHandle& s, const py::handle& origins, cons
   return out;
 }
 
-std::shared_ptr<SceneHandle> load(const std::string& name, float scale, std::array<float, 3> offset,
+// The scene of a Python Scene (`self`); ValueError for an empty one (arguments.h scene_arg).
+const pb::Scene& scene_of(const py::handle& self) { return pb::python::scene_arg(self, "self").scene(); }
+
+std::shared_ptr<SceneHandle> load(const py::handle& name_or_path, float scale, std::array<float, 3> offset,
                                   const std::string& embree_layout, bool strict) {
+  const std::string name = pb::python::path_arg(name_or_path, "name_or_path");
   EmbreeLayout layout;
   try {
     layout = parse_embree_layout(embree_layout);
@@ -148,10 +154,10 @@ PYBIND11_MODULE(_core, m) {
   py::class_<SceneHandle, std::shared_ptr<SceneHandle>>(m, "Scene",
                                                         "A finalized scene (zero-area triangles dropped); "
                                                         "primitive ids index `triangles`.")
-      .def_property_readonly("name", [](const SceneHandle& s) { return s.scene().name; })
+      .def_property_readonly("name", [](const py::handle& self) { return pb::python::text(scene_of(self).name); })
       .def_property_readonly("positions",
                              [](py::object self) -> py::array {
-                               const auto& s = self.cast<const SceneHandle&>().scene();
+                               const auto& s = scene_of(self);
                                const std::vector<py::ssize_t> shape{py::ssize_t(s.positions.size()), 3};
                                if (is_zero(s.origin)) return view(&s.positions.data()->x, shape, self);
                                // Moved next to the origin to be traced: give back the user's
@@ -166,18 +172,18 @@ PYBIND11_MODULE(_core, m) {
                              "(N, 3) float32 vertex positions (read-only)")
       .def_property_readonly("triangles",
                              [](py::object self) -> py::array {
-                               const auto& s = self.cast<const SceneHandle&>().scene();
+                               const auto& s = scene_of(self);
                                return view(s.triangles.data()->v, {py::ssize_t(s.triangles.size()), 3}, self);
                              },
                              "(M, 3) uint32 vertex indices (read-only view)")
       .def_property_readonly("material_ids",
                              [](py::object self) -> py::array {
-                               const auto& s = self.cast<const SceneHandle&>().scene();
+                               const auto& s = scene_of(self);
                                return view(s.material_ids.data(), {py::ssize_t(s.material_ids.size())}, self);
                              })
       .def_property_readonly("bounds",
-                             [](const SceneHandle& h) {
-                               const auto& s = h.scene();
+                             [](const py::handle& self) {
+                               const auto& s = scene_of(self);
                                py::array_t<float> b({2, 3});
                                float* p = b.mutable_data();
                                for (int k = 0; k < 3; ++k) {
@@ -187,9 +193,10 @@ PYBIND11_MODULE(_core, m) {
                                return b;
                              },
                              "(2, 3) float32: [min corner, max corner]")
-      .def_property_readonly("extent", [](const SceneHandle& s) { return s.scene().features.extent; })
-      .def_property_readonly("num_triangles", [](const SceneHandle& s) { return s.scene().triangles.size(); })
-      .def_property_readonly("dropped_triangles", [](const SceneHandle& s) { return s.scene().dropped_triangles; })
+      .def_property_readonly("extent", [](const py::handle& self) { return scene_of(self).features.extent; })
+      .def_property_readonly("num_triangles", [](const py::handle& self) { return scene_of(self).triangles.size(); })
+      .def_property_readonly("dropped_triangles",
+                             [](const py::handle& self) { return scene_of(self).dropped_triangles; })
       .def("intersect", &intersect, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::kw_only(), py::arg("backend") = "embree",
            py::arg("watertight") = true,
@@ -199,9 +206,22 @@ PYBIND11_MODULE(_core, m) {
       .def("occluded", &occluded, py::arg("origins"), py::arg("directions"), py::arg("tnear") = 0.0f,
            py::arg("tfar") = std::numeric_limits<float>::infinity(), py::kw_only(), py::arg("backend") = "embree",
            py::arg("watertight") = true, "Any hit in (tnear, tfar): bool (N,).")
-      .def("__repr__", [](const SceneHandle& s) {
-        return fmt::format("<pathbench.Scene '{}': {} triangles, {} vertices>", s.scene().name,
-                           s.scene().triangles.size(), s.scene().positions.size());
+      .def("__repr__", [](const py::handle& self) -> std::string {
+        const SceneHandle* h = nullptr;
+        try {
+          h = &pb::python::scene_arg(self, "self");
+        } catch (const py::value_error&) {
+          return "<pathbench.Scene (empty: not made by load_scene)>";
+        }
+        return fmt::format("<pathbench.Scene {}: {} triangles, {} vertices>", py::repr(pb::python::text(h->scene().name)).cast<std::string>(),
+                           h->scene().triangles.size(), h->scene().positions.size());
+      })
+      // A scene is read-only: a copy is the same scene (copy.copy would otherwise make an
+      // empty one through Scene.__new__).
+      .def("__copy__", [](const py::object& self) { return self; })
+      .def("__deepcopy__", [](const py::object& self, const py::handle&) { return self; }, py::arg("memo"))
+      .def("__reduce__", [](const py::handle&) -> py::object {
+        throw py::type_error("a pathbench.Scene cannot be pickled; load it again with pathbench.load_scene");
       });
 
   m.def("load_scene", &load, py::arg("name_or_path"), py::arg("scale") = 1.0f,
@@ -214,7 +234,7 @@ PYBIND11_MODULE(_core, m) {
         "names what is wrong.");
   m.def("builtin_scenes", [] {
     py::list out;
-    for (const auto& b : pb::builtin_scenes()) out.append(py::make_tuple(b.name, b.description));
+    for (const auto& b : pb::builtin_scenes()) out.append(py::make_tuple(b.name, b.description));  // ASCII
     return out;
   });
   pb::python::def_render(m);

@@ -25,7 +25,7 @@ py::object to_python(const nlohmann::json& j) {
   switch (j.type()) {
     case nlohmann::json::value_t::object: {
       py::dict d;
-      for (const auto& [k, v] : j.items()) d[py::str(k)] = to_python(v);
+      for (const auto& [k, v] : j.items()) d[text(k)] = to_python(v);
       return std::move(d);
     }
     case nlohmann::json::value_t::array: {
@@ -33,7 +33,7 @@ py::object to_python(const nlohmann::json& j) {
       for (const auto& v : j) l.append(to_python(v));
       return std::move(l);
     }
-    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::string: return text(j.get_ref<const std::string&>());
     case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
     case nlohmann::json::value_t::number_integer: return py::int_(j.get<int64_t>());
     case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<uint64_t>());
@@ -51,13 +51,14 @@ py::array_t<float> image(const std::vector<float>& pixels, uint32_t width, uint3
 constexpr int64_t kU32 = std::numeric_limits<uint32_t>::max();
 constexpr int64_t kI32 = std::numeric_limits<int32_t>::max();
 
-py::tuple render(const SceneHandle& s, const py::object& width, const py::object& height, const py::object& spp,
+py::tuple render(const py::handle& scene, const py::object& width, const py::object& height, const py::object& spp,
                  const py::object& bounces, const py::object& converged, const py::object& rr,
                  const py::object& sampling, const py::object& strategy, const py::object& device,
                  const py::object& precision, const py::object& embree_layout, const py::object& isa,
                  const py::object& instancing, const py::object& seed,
                  const py::object& paths_in_flight, const py::object& threads, const py::object& watertight,
                  const py::object& variance, const py::object& profile) {
+  const SceneHandle& s = scene_arg(scene, "scene");
   RenderSettings rs;
   RenderChoices c;
   rs.width = uint32_t(int_arg(width, "width", 0, kU32));

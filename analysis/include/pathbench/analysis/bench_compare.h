@@ -56,12 +56,33 @@ struct BenchSeries {
   bool error = false;
   std::string error_message;
 };
+// What compare reads of a file's "context" (analysis/src/compare_context.cpp), read
+// once when the file is read with every field's type and range checked: a field of the
+// wrong type is bad input naming the file and the field, never a failure later.
+struct BenchContext {
+  std::string git_revision = "unknown", date = "?", machine = "?";
+  bool has_fingerprint = false;           // context.fingerprint (pathbench's machine fingerprint)
+  std::string machine_id;                 // its machine_id: required in a fingerprint
+  nlohmann::json identity;                // its {cpu, memory_gib}, to say how machines differ
+  nlohmann::json build;                   // its {build, libraries}
+  nlohmann::json gpu_id;                  // its gpu.gpu_id (null: no GPU)
+  std::string gpu_name = "none";          // its gpu.name, else gpu.none
+  nlohmann::json gb_machine;              // Google Benchmark's CPU facts (files without a fingerprint)
+  nlohmann::json gb_build;                // compiler, cxx_flags, build_type, embree_version
+  nlohmann::json settings;                // pathbench_preset, cpu_tbb_threads
+  nlohmann::json load_avg;                // load_avg as given (null: none)
+  double load1 = -1;                      // load_avg[0]; -1: not given
+  double cpu_per_wall = -1;               // run.cpu_per_wall; -1: not given
+  double num_cpus = -1;                   // num_cpus; -1: not given
+};
+
 // Keyed by run name, in file order of first appearance (second: order index).
 struct BenchFile {
   std::string path;
   std::map<std::string, BenchSeries> series;
   std::vector<std::string> order;
   nlohmann::json context;               // the file's "context" object
+  BenchContext run;                     // what compare reads of it, checked
 };
 // Google Benchmark JSON text parsed with its bare NaN / inf values read as null, keys
 // in file order. Throws InputError naming `path` when it is not JSON.

@@ -60,4 +60,22 @@ inline constexpr uint64_t kMaxMtlBytes = uint64_t(16) << 20;         // MTL mate
 inline constexpr uint64_t kMaxBenchJsonBytes = uint64_t(64) << 20;   // compare's benchmark JSON files
 inline constexpr uint64_t kMaxImageBytes = uint64_t(1) << 30;        // reference images (.pfm)
 
+// Render sizes (RenderSettings::validate; `pathbench render`, bench, accuracy, crosscheck
+// and the Python module all validate through it). Every product is formed in 64 bits
+// from 32-bit factors, so none can wrap before it is compared.
+// Pixels in one image: 2^28 is 16384 x 16384, whose film (28 bytes a pixel, 52 with
+// variance) and float image (12 more) take 10 to 17 GB.
+inline constexpr uint64_t kMaxPixels = uint64_t(1) << 28;
+// Samples in one frame (pixels x spp): 2^48 keeps the 64-bit ray, path and sample
+// counters far from wrapping at any path length (2^48 x 2^15 rays < 2^64), and is
+// days of tracing at 10^9 samples/s.
+inline constexpr uint64_t kMaxFrameSamples = uint64_t(1) << 48;
+// Paths the ray-parallel strategy keeps in flight (--paths-in-flight): the GPU indexes
+// its pool with 32 bits.
+inline constexpr uint64_t kMaxPathsInFlight = 0xFFFFFFFFull;
+// Host bytes a pixel costs a render: the film's sums and count (3 x 8 + 4), the float
+// image made from them (3 x 4); with variance 3 x 8 sums of squares and a float image more.
+inline constexpr uint64_t kFilmBytesPerPixel = 3 * 8 + 4 + 3 * 4;
+inline constexpr uint64_t kVarianceBytesPerPixel = 3 * 8 + 3 * 4;
+
 }  // namespace pb::limits

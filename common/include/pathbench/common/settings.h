@@ -108,6 +108,12 @@ struct RenderChoices {
 // as a whole are validated once, by the run layer (pathbench/run/run.h) before it renders.
 void apply_choices(const RenderChoices& c, RenderSettings& s);
 
+// Throws InputError (naming --width/--height) for an image of no pixels, of more than
+// limits::kMaxPixels, or whose film (with `variance` sums) would not fit this machine's
+// memory. RenderSettings::validate calls it, and so does Film's constructor, so that no
+// caller sizes a film it did not check.
+void check_image_size(uint32_t width, uint32_t height, bool variance);
+
 const char* to_string(Sampling s);
 const char* to_string(Strategy s);
 const char* to_string(Device d);
