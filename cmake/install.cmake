@@ -18,3 +18,8 @@ endforeach()
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/tools/" DESTINATION "${pathbench_install_datadir}/pathbench/tools" COMPONENT cli
         FILES_MATCHING PATTERN "*.py" PATTERN "*.md" PATTERN "*.css" PATTERN "*.js" PATTERN "requirements*.txt"
         PATTERN "__pycache__" EXCLUDE PATTERN "isa_cap" EXCLUDE)
+# The project's history export (the reference machines' runs), which `history changes` and
+# `report` build the per-user database from on first use (tools/history/cli.py).
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/results/history/runs/"
+        DESTINATION "${pathbench_install_datadir}/pathbench/results/history/runs" COMPONENT cli
+        FILES_MATCHING PATTERN "*.jsonl")

@@ -228,6 +228,12 @@ def test_installed_pathbench_stands_alone(tmp_path):
     p = run("history", "report", "--db", str(db), "--out", str(tmp_path / "d"))
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "d" / "index.html").exists()
+    # No --db at all: the per-user database, built on first use from the installed export.
+    env["XDG_DATA_HOME"] = str(tmp_path / "xdg")
+    p = run("history", "report", "--out", str(tmp_path / "d2"))
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "d2" / "index.html").exists() and (tmp_path / "xdg/pathbench/history.sqlite").exists()
+    assert "share/pathbench/results/history/runs" in p.stderr
     p = run("accuracy", "--quick", "--out-dir", str(tmp_path / "acc"))
     assert p.returncode == 0, p.stderr
     # A Python without Mitsuba (or none at all): one clear line, exit 2.

@@ -17,8 +17,15 @@ import sys
 from .text import term
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DEFAULT_DB = os.path.join(ROOT, "results", "history", "history.sqlite")
-DEFAULT_RUNS = os.path.join(ROOT, "results", "history", "runs")  # the project's text export
+# The project's text export: in a source tree results/history/runs; `cmake --install` and
+# `pip install .` lay it down beside the tools (share/pathbench/results/history/runs).
+DEFAULT_RUNS = os.path.join(ROOT, "results", "history", "runs")
+# The database: in a source tree (a checkout has .git) results/history/history.sqlite (git-ignored);
+# an installed pathbench has no writable tree, so the per-user data folder, as `pathbench suite`.
+IN_SOURCE_TREE = os.path.exists(os.path.join(ROOT, ".git"))
+DEFAULT_DB = (os.path.join(ROOT, "results", "history", "history.sqlite") if IN_SOURCE_TREE else
+              os.path.join(os.environ.get("XDG_DATA_HOME") or os.path.join(os.path.expanduser("~"), ".local", "share"),
+                           "pathbench", "history.sqlite"))
 PROG = "pathbench history"
 
 
@@ -79,6 +86,13 @@ def cmd_rebuild(a) -> int:
 
 def _open(path: str):
     from . import store
+    if path == DEFAULT_DB and not os.path.exists(path) and os.path.isdir(DEFAULT_RUNS):
+        # First use of the default database: build it from the project's export, so that
+        # `changes` and `report` work at once (an installed pathbench included).
+        from . import export
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        n = export.rebuild(DEFAULT_RUNS, path)
+        print(f"{PROG}: built {term(path)} from the {n} run files in {term(DEFAULT_RUNS)}", file=sys.stderr)
     return store.connect(path, create=False, readonly=True)
 
 
@@ -158,7 +172,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="cmd", required=True, parser_class=_Parser)
 
     def with_db(p):
-        p.add_argument("--db", default=DEFAULT_DB, help="SQLite database (default: results/history/history.sqlite)")
+        p.add_argument("--db", default=DEFAULT_DB, help="SQLite database (default: results/history/history.sqlite in a source tree, else $XDG_DATA_HOME/pathbench/history.sqlite; changes and report build it from the project's export when missing)")
         return p
 
     p = with_db(sub.add_parser("record", help="store bench JSON / render reports (all or none, one transaction)"))
