@@ -134,7 +134,7 @@ def test_a_render_timed_at_zero_is_named():
 def test_a_tiny_run_end_to_end(tmp_path):
     pytest.importorskip("mitsuba")
     db = tmp_path / "h.sqlite"
-    r = subprocess.run([sys.executable, str(ROOT / "tools" / "mitsuba_speed.py"), "--size", "16", "--spp", "16",
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "mitsuba_speed.py"), "--size", "48", "--spp", "64",
                         "--rounds", "2", "--mitsuba-per-round", "2", "--strategies", "wavefront", "--no-raw",
                         "--out-dir", str(tmp_path), "--history-db", str(db)], capture_output=True, text=True)
     if r.returncode != 0 and "libLLVM" in r.stderr + r.stdout:
