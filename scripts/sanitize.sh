@@ -20,7 +20,7 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
 # as leaks; the unit and CLI tests run the one-rank world, run/src/single_world.cpp.)
 cmake --build build-asan --parallel "$(nproc)" --target pathbench pathbench_unit_tests pathbench_bench_tests \
   pathbench_traversal_tests pathbench_host_tracer_tests fuzz_scene_json_replay fuzz_obj_replay fuzz_bench_json_replay fuzz_ply_replay \
-  fuzz_gltf_replay fuzz_mitsuba_replay fuzz_compare_context_replay
+  fuzz_gltf_replay fuzz_mitsuba_replay fuzz_compare_context_replay fuzz_off_replay
 # Leaks are errors; TBB's and Embree's process-lifetime allocations are not ours.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/tests/sanitizer/lsan.supp:print_suppressions=0}
