@@ -4,9 +4,16 @@
 # CPU+GPU hybrid give the one-GPU image byte for byte, that pathbench-bench's GPU render
 # benchmarks over 2 ranks give one process's film hashes, and run tools/mpi_scaling.py.
 # Everything lands under $OUT (default ./device-out). Phases: build gpu check bench reduce scaling
-# hybrid (gpu: ctest -L gpu in the same build, GPU_TESTS=regex for a subset; hybrid: one GPU
-# alone against the hybrid, interleaved rounds, REPS=5 by default; scaling: tools/mpi_scaling.py
-# --gpus <all visible>, SCALING_REPS=3, CPU_RANKS=1,2,4). TARGETS: what to build.
+# hybrid cache bands repeat largemesh (gpu: ctest -L gpu in the same build, GPU_TESTS=regex for a
+# subset; hybrid: one GPU alone against the hybrid, interleaved rounds, REPS=5 by default;
+# scaling: tools/mpi_scaling.py --gpus <all visible>, SCALING_REPS=3, CPU_RANKS=1,2,4,
+# HYBRID_ROUNDS (REPS), RECORD=1 records it into the history (--commit $PATHBENCH_SOURCE_COMMIT);
+# cache: the hybrid with and without gpu::render's kept setup (PATHBENCH_GPU_RENDER_CACHE=0)
+# against one GPU, interleaved, CACHE_REPS=5; bands: 2 GPU ranks reducing at the end against band
+# by band (PATHBENCH_REDUCE_BANDS), BANDS_REPS=3; repeat: CPU ranks' images against one
+# process's, REPEAT_RUNS=8 times each (the NOT IDENTICAL hunt); largemesh: the suite's large
+# mesh on one GPU and over the GPU ranks, PATHBENCH_DATA_DIR holding its mesh). TARGETS: what
+# to build. PB=path: a pathbench built elsewhere (then `build` only checks that it runs).
 #   source .gpu-deps/unpack.sh is done here (pack-deps.sh --mpi); ../shared/gpu-host/README.md.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -21,11 +28,20 @@ if [ -f .gpu-deps/unpack.sh ]; then source .gpu-deps/unpack.sh >/dev/null; fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 NCCL_NVLS_ENABLE=0
 MPIRUN=$(command -v mpirun.openmpi || command -v mpirun)
 B=build-mpi
-PB=$B/bin/pathbench
+PB=${PB:-$B/bin/pathbench}
 gpus=$(nvidia-smi -L | wc -l)
 log "GPUs: $gpus, mpirun: $MPIRUN"
 
-if has build; then
+if has build && [ "$PB" != "$B/bin/pathbench" ]; then
+  # A binary built elsewhere: it must find its libraries and run here, else build it.
+  if ldd "$PB" | grep -q "not found" || ! "$PB" render --quiet --device gpu --width 8 --height 8 --spp 1 --out /tmp/pb-smoke.pfm; then
+    log "the given pathbench ($PB) does not run here: $(ldd "$PB" | grep 'not found' | tr '\n' ' '): building"
+    PB=$B/bin/pathbench
+  else
+    log "using the given pathbench $PB"
+  fi
+fi
+if has build && [ "$PB" = "$B/bin/pathbench" ]; then
   cmake -S . -B $B -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF -DPATHBENCH_PYTHON=OFF \
         -DPATHBENCH_MPI=ON -DMPI_CXX_COMPILER=$(command -v mpicxx.openmpi || command -v mpicxx) \
         -DPATHBENCH_NCCL=${PATHBENCH_NCCL:-AUTO} \
@@ -127,9 +143,86 @@ if has reduce; then
     log "reduce $(basename "$p" .json): $(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['ranks']; print(f\"frame {r['frame_seconds']:.5f} s reduce {r['reduce_seconds']:.5f} s ({r['reduction']['gpu_ranks']}) parts\", [p.get('reduce_parts') for p in r['per_rank']][0])" "$p")"
   done
 fi
+if has cache; then
+  # Interleaved rounds at each frame: one GPU process, the hybrid (1 GPU + 1 CPU rank, MPMD)
+  # with gpu::render's kept setup, and without it (PATHBENCH_GPU_RENDER_CACHE=0, both ranks).
+  mkdir -p "$OUT/ab/cache"
+  for frame in "256 256 800" "2048 2048 1024"; do
+    set -- $frame
+    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2"
+    reps=${CACHE_REPS:-5}; [ "$1" = 2048 ] && reps=${CACHE_REPS_BIG:-3}
+    for i in $(seq 1 $reps); do
+      $PB $f --device gpu --out "$OUT/g.pfm" --report "$OUT/ab/cache/gpu-$1-$i.json"
+      for arm in on off; do
+        c=1; [ $arm = off ] && c=0
+        PATHBENCH_GPU_RENDER_CACHE=$c mpi -x PATHBENCH_GPU_RENDER_CACHE -np 1 $PB $f --device gpu --out "$OUT/h.pfm" \
+            --report "$OUT/ab/cache/$arm-$1-$i.json" : -np 1 $PB $f --device cpu --out "$OUT/h.pfm" \
+            --report "$OUT/ab/cache/$arm-$1-$i.json"
+        same "$OUT/g.pfm" "$OUT/h.pfm" "$1x$2x$3 round $i: hybrid (cache $arm) vs one GPU"
+      done
+    done
+  done
+  rm -f "$OUT"/*.pfm
+fi
+if has bands; then
+  # 2 GPU ranks: the film reduced at the end (1 band) against band by band while tracing
+  # (auto, and 4 at the small frame, where auto keeps one band), interleaved rounds.
+  mkdir -p "$OUT/ab/bands"
+  for frame in "256 256 800" "2048 2048 1024"; do
+    set -- $frame
+    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2 --device gpu"
+    arms="1 auto"; [ "$1" = 256 ] && arms="1 auto 4"
+    for i in $(seq 1 ${BANDS_REPS:-3}); do
+      for b in $arms; do
+        PATHBENCH_REDUCE_BANDS=$b mpi -x PATHBENCH_REDUCE_BANDS -np 2 $PB $f --out "$OUT/b.pfm" \
+            --report "$OUT/ab/bands/b$b-$1-$i.json"
+      done
+    done
+  done
+  rm -f "$OUT"/*.pfm
+fi
+if has cache || has bands; then
+  python3 tools/mpi_scaling_ab.py "$OUT/ab" | tee "$OUT/ab.md" | tee -a "$OUT/summary.txt"
+fi
 if has scaling; then
+  rec=(); [ "${RECORD:-0}" = 1 ] && rec=(--record ${PATHBENCH_SOURCE_COMMIT:+--commit "$PATHBENCH_SOURCE_COMMIT"})
   PYTHONUNBUFFERED=1 python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" \
-      --cpu-ranks "${CPU_RANKS-1,2,4}" --reps "${SCALING_REPS:-3}" --hybrid-rounds "${REPS:-5}" \
-      --out-dir "$OUT/scaling" > "$OUT/scaling.txt" 2>&1
-  log "scaling: $(grep -E '^\||NOT IDENTICAL' "$OUT/scaling.txt")"
+      --cpu-ranks "${CPU_RANKS-1,2,4}" --reps "${SCALING_REPS:-3}" --hybrid-rounds "${HYBRID_ROUNDS:-${REPS:-5}}" \
+      --out-dir "$OUT/scaling" "${rec[@]}" > "$OUT/scaling.txt" 2>&1
+  log "scaling: $(grep -E '^\||NOT IDENTICAL|recorded' "$OUT/scaling.txt")"
+fi
+if has repeat; then
+  # The NOT IDENTICAL hunt (issue 30): CPU ranks (static, and dynamic), image bytes and film
+  # hash of every run against one CPU process's, REPEAT_RUNS times each.
+  mkdir -p "$OUT/repeat"
+  f="render --quiet --width 256 --height 256 --spp 800 --bounces 2 --device cpu"
+  $PB $f --out "$OUT/repeat/one.pfm" --report "$OUT/repeat/one.json"
+  ref=$(sha256sum < "$OUT/repeat/one.pfm"); refh=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['film_hash'])" "$OUT/repeat/one.json")
+  diff=0; total=0
+  for i in $(seq 1 ${REPEAT_RUNS:-8}); do
+    for np in 2 4; do
+      for bal in static dynamic; do
+        mpi -np $np $PB $f --balance $bal --out "$OUT/repeat/x.pfm" --report "$OUT/repeat/x.json"
+        total=$((total + 1))
+        h=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['film_hash'])" "$OUT/repeat/x.json")
+        if [ "$(sha256sum < "$OUT/repeat/x.pfm")" != "$ref" ] || [ "$h" != "$refh" ]; then
+          diff=$((diff + 1)); cp "$OUT/repeat/x.pfm" "$OUT/repeat/diff-$i-$np-$bal.pfm"; cp "$OUT/repeat/x.json" "$OUT/repeat/diff-$i-$np-$bal.json"
+          log "repeat $i -np $np $bal: DIFFERENT (film hash $h vs $refh)"
+        fi
+      done
+    done
+  done
+  log "repeat: $diff of $total CPU-rank runs (256x256x800, -np 2 and 4, static and dynamic) differ from one process"
+  rm -f "$OUT"/repeat/*.pfm
+fi
+if has largemesh; then
+  # The suite's large mesh (13.3 M triangles, Loop-subdivided armadillo) on one GPU and over
+  # every GPU (one rank each): frame, reduction and film hash.
+  mkdir -p "$OUT/largemesh"
+  f="render --quiet --scene scenes/suite/large-mesh.json --width 256 --height 256 --spp 800 --bounces 2 --sampling nee --device gpu"
+  $PB $f --out "$OUT/lm1.pfm" --report "$OUT/largemesh/gpu1.json"
+  mpi -np "$gpus" $PB $f --out "$OUT/lmN.pfm" --report "$OUT/largemesh/gpu$gpus.json"
+  same "$OUT/lm1.pfm" "$OUT/lmN.pfm" "large-mesh 256x256x800: $gpus GPU ranks vs one GPU"
+  log "large-mesh seconds [frame share efficiency reduce]: 1 GPU $(secs "$OUT/largemesh/gpu1.json") + download $(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('film_download_seconds'))" "$OUT/largemesh/gpu1.json") | $gpus GPUs $(secs "$OUT/largemesh/gpu$gpus.json")"
+  rm -f "$OUT"/lm*.pfm
 fi

@@ -316,6 +316,8 @@ def summary(runs: list[dict]) -> str:
     for x in runs:
         eff = x.get("strong_efficiency") if x["experiment"].startswith("strong") else x.get("weak_efficiency")
         red = (x.get("reduction") or {}).get("gpu_ranks", "")
+        bands = (x.get("reduction") or {}).get("bands") or 1
+        red += f", {bands} bands" if bands > 1 else ""
         f = lambda v, p=3: "" if v is None else f"{v:.{p}f}"  # noqa: E731
         lines.append(f"| {x['experiment']} | {x['width']}x{x['height']}x{x['spp']} | {x['ranks']} | "
                      f"{f(x['seconds'], 4)} | {f(x.get('speedup'), 2)} | {f(eff, 2)} | "

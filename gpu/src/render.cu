@@ -4,6 +4,8 @@
 // The rooms it calls: device_film.cuh (film + counters), pixel.cu (megakernel),
 // wavefront_state.cuh / wavefront_stages.cuh / path_pool.cu (wavefront, paper-queue),
 // scene_upload.cu, device_facts.cu, trace.cu (traversal alone), cuda_util (launches).
+// What a render sets up the same way every time (stream, events, launcher, counters, the
+// device's facts; a kept film's pools) is kept for the process's next render: RenderCache.
 #include "pathbench/gpu/render.h"
 
 #include <cuda_runtime.h>
@@ -14,7 +16,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "cuda_util.h"
@@ -61,6 +65,7 @@ double download_film(const FilmBuffers& fb, Film& film) {
 
 void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
                  RunReport& report, bool profile, DeviceFilm* keep);
+bool render_cache_enabled();  // PATHBENCH_GPU_RENDER_CACHE (below)
 }  // namespace
 
 double DeviceFilm::download(Film& film) const {
@@ -94,23 +99,90 @@ void render(const Scene& scene, const RenderSettings& settings, Film& film, RunR
 
 void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film, RunReport& report,
             bool profile, DeviceFilm* keep) {
-  DeviceMemory::instance().begin_measurement();
+  // A kept film's later renders (an MPI rank's chunks) go on with its first render's
+  // measurement: the same film, scene and kept resources (two cudaMemGetInfo calls less).
+  if (!keep || !keep->used() || !render_cache_enabled()) DeviceMemory::instance().begin_measurement();
   render_impl(scene, gpu_scene, settings, film, report, profile, keep);
 }
 
 namespace {
+// What gpu::render keeps across the calls of a process (issue 30: the hybrid's GPU rank paid
+// ~0.37 ms a call for it, outside the timed frame, and a one-GPU process none): the
+// device's facts (cudaGetDeviceProperties, the driver's version file), the render's stream
+// and timing events, the launcher (its stages' occupancy queries), the pixel strategy's
+// counter block, and, for a kept film (an MPI rank's chunks), the wavefront's pools while
+// the next chunk asks for pools of the same sizes. One device a cache (an MPI rank's): a
+// render on another device, one while another thread renders, or any render with
+// PATHBENCH_GPU_RENDER_CACHE=0 makes its own, as before. Never destroyed (CUDA may be torn
+// down first at exit, as DeviceMemory's ledger says).
+struct RenderCache {
+  explicit RenderCache(int d) : device(d), info(device_info()), driver(kernel_driver_version()), launch(stream.s, false) {}
+  const int device;
+  const DeviceInfo info;
+  const std::string driver;
+  ScopedStream stream;
+  ScopedEvent ev0, ev1;
+  Launcher launch;  // not profiling: a profiled render's launcher records events of its own
+  DeviceBuffer<PixelCounters> pixel_counters;
+  // A kept film's wavefront pools, their sizes and shadow records.
+  std::vector<std::unique_ptr<PathPool>> pools;
+  std::vector<std::unique_ptr<ScopedStream>> pool_streams;
+  std::vector<uint64_t> pool_caps;
+  ShadowUse pool_shadows;
+  // default_paths_in_flight's last answer (it reads the device's properties) and its question.
+  uint64_t pif_bytes_per_path = 0, pif_bytes_in_use = 0, pif = 0;
+  // Any render that does not use the kept pools releases them: no device memory is held
+  // beside a render (or in its measurement) for pools it does not run.
+  void drop_pools() {
+    pools.clear();
+    pool_streams.clear();
+    pool_caps.clear();
+  }
+};
+
+bool render_cache_enabled() {
+  static const bool on = [] {
+    const char* v = std::getenv("PATHBENCH_GPU_RENDER_CACHE");
+    const std::string s = v ? v : "";
+    if (s.empty() || s == "1" || s == "on") return true;
+    if (s == "0" || s == "off") return false;
+    throw InputError(fmt::format("PATHBENCH_GPU_RENDER_CACHE='{}': expected 1, on, 0 or off", s));
+  }();
+  return on;
+}
+
+std::mutex render_cache_mutex;
+RenderCache* render_cache = nullptr;  // guarded by render_cache_mutex
+
+// The cache for one render, held (locked) while the render lives; null where it cannot serve.
+struct CacheLease {
+  std::unique_lock<std::mutex> lock{render_cache_mutex, std::defer_lock};
+  RenderCache* cache = nullptr;
+  CacheLease() {
+    if (!render_cache_enabled() || !lock.try_lock()) return;
+    ensure_device();  // no device: its InputError, as without the cache
+    int device = 0;
+    PB_CUDA_CHECK(cudaGetDevice(&device));
+    if (!render_cache) render_cache = new RenderCache(device);
+    if (render_cache->device == device) cache = render_cache;
+    else lock.unlock();
+  }
+};
+
 // 1. Setup: the film on the device (this render's own, or a kept one that earlier renders,
 // an MPI rank's chunks, added into, allocated and warmed up by the first of them), and the
 // strategy's resources sized for the render's samples. The run layer has checked the
 // settings for the GPU (validate_for_tracer) and the device (device_info is cached).
 struct RenderSetup {
   RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& s, const Film& film, bool profile,
-              DeviceFilm* keep);
+              DeviceFilm* keep, RenderCache* cache);
   // The kernels of the settings' strategy over `n` of the render's samples.
   FrameResult run_frame(uint64_t n, bool variance);
 
   const RenderSettings& settings;
-  const DeviceInfo info = device_info();
+  RenderCache* const cache;  // null: everything below is this render's own
+  const DeviceInfo info;
+  const std::string driver;
   const GpuScene::Impl& g;
   const PathConfig config;
   // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share):
@@ -119,15 +191,19 @@ struct RenderSetup {
   const uint32_t spp;
   const ShadowUse shadows;
 
-  ScopedStream stream;
-  Launcher launch;
+  std::unique_ptr<ScopedStream> own_stream;  // without a cache
+  const cudaStream_t stream;
+  std::unique_ptr<Launcher> own_launch;  // without a cache, or profiling
+  Launcher& launch;
   FilmBuffers own;
   FilmBuffers& fb;
   const bool first_use;
 
-  std::vector<std::unique_ptr<PathPool>> pools;  // wavefront: wavefront_pools(...) of them; paper-queue: one
-  std::vector<std::unique_ptr<ScopedStream>> pool_streams;  // the wavefront's pools beyond the first
-  DeviceBuffer<PixelCounters> pixel_counters;
+  std::vector<std::unique_ptr<PathPool>> own_pools;  // wavefront: wavefront_pools(...) of them; paper-queue: one
+  std::vector<std::unique_ptr<ScopedStream>> own_pool_streams;  // the wavefront's pools beyond the first
+  DeviceBuffer<PixelCounters> own_pixel_counters;
+  DeviceBuffer<PixelCounters>& pixel_counters;
+  size_t pool_count = 0;
   uint64_t warmup_total;
   PixelOccupancy occupancy;
   std::vector<PathPool*> pool_ptrs;
@@ -135,16 +211,27 @@ struct RenderSetup {
 };
 
 RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& s, const Film& film,
-                         bool profile, DeviceFilm* keep)
+                         bool profile, DeviceFilm* keep, RenderCache* c)
     : settings(s),
+      cache(c),
+      info(c ? c->info : device_info()),
+      driver(c ? c->driver : kernel_driver_version()),
       g(gpu_scene.impl()),
       config(s.path_config()),
       total(s.traced_samples()),
       spp(s.traced_spp()),
       shadows(ShadowUse::of(scene, s)),
-      launch(stream.s, profile),
+      own_stream(c ? nullptr : std::make_unique<ScopedStream>()),
+      stream(c ? c->stream.s : own_stream->s),
+      own_launch(c && !profile ? nullptr : std::make_unique<Launcher>(stream, profile)),
+      launch(own_launch ? *own_launch : c->launch),
       fb(keep ? keep->impl().fb : own),
-      first_use(!keep || !keep->impl().used) {
+      first_use(!keep || !keep->impl().used),
+      pixel_counters(c ? c->pixel_counters : own_pixel_counters) {
+  if (!own_launch) {  // the kept launcher, as a new one starts
+    launch.set_stream(stream);
+    launch.clear();
+  }
   const uint32_t pixels = s.width * s.height;
   if (keep && keep->impl().used) {
     const DeviceFilm::Impl& k = keep->impl();
@@ -154,23 +241,52 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
   if (first_use) fb.allocate(film, pixels);
 
   warmup_total = std::min<uint64_t>(total, pixels);
+  std::vector<std::unique_ptr<PathPool>>* pools = &own_pools;
+  std::vector<std::unique_ptr<ScopedStream>>* pool_streams = &own_pool_streams;
   if (s.strategy == Strategy::Pixel) {
-    pixel_counters.allocate(1, "counters", "nothing (a few bytes)");
+    if (cache) cache->drop_pools();
+    if (!pixel_counters.get()) pixel_counters.allocate(1, "counters", "nothing (a few bytes)");
   } else if (s.strategy == Strategy::Wavefront) {
-    uint64_t pif = s.paths_in_flight ? s.paths_in_flight
-                                     : default_paths_in_flight(PathPool::state_bytes(shadows), fb.bytes() + g.bytes);
+    const uint64_t per_path = PathPool::state_bytes(shadows), in_use = fb.bytes() + g.bytes;
+    uint64_t pif = s.paths_in_flight;
+    if (!pif && cache && cache->pif && cache->pif_bytes_per_path == per_path && cache->pif_bytes_in_use == in_use)
+      pif = cache->pif;
+    if (!pif) {
+      pif = default_paths_in_flight(per_path, in_use);
+      if (cache) cache->pif_bytes_per_path = per_path, cache->pif_bytes_in_use = in_use, cache->pif = pif;
+    }
     pif = std::min<uint64_t>(pif, total);
     pif = std::max<uint64_t>(pif, 1);
     if (pif > 0xFFFFFFFFull) throw InputError("--paths-in-flight: at most 4294967295 paths");
     // Under --profile one pool: each stage's events then bracket its own work alone.
     const uint64_t n = std::min<uint64_t>(profile ? 1 : uint64_t(wavefront_pools(total, pif)), pif);
-    for (uint64_t k = 0; k < n; ++k) {  // pif split as evenly as it goes
-      const uint64_t cap = pif * (k + 1) / n - pif * k / n;
-      pools.push_back(std::make_unique<PathPool>(cap, shadows, "the wavefront path pool", "--paths-in-flight"));
-      if (k > 0) pool_streams.push_back(std::make_unique<ScopedStream>());
+    std::vector<uint64_t> caps;
+    for (uint64_t k = 0; k < n; ++k) caps.push_back(pif * (k + 1) / n - pif * k / n);  // pif split as evenly as it goes
+    if (cache && keep) {
+      // A kept film's chunks: the cached pools where they are the same, else new ones in
+      // their place (the old released first: no two sets at once).
+      pools = &cache->pools;
+      pool_streams = &cache->pool_streams;
+      const bool same = cache->pool_caps == caps && cache->pool_shadows.records == shadows.records &&
+                        cache->pool_shadows.pairs == shadows.pairs;
+      if (!same) cache->drop_pools();
+    } else if (cache) {  // a render of its own: no pools kept beside it
+      cache->drop_pools();
+    }
+    if (pools->empty()) {
+      for (uint64_t k = 0; k < n; ++k) {
+        pools->push_back(std::make_unique<PathPool>(caps[k], shadows, "the wavefront path pool", "--paths-in-flight"));
+        if (k > 0) pool_streams->push_back(std::make_unique<ScopedStream>());
+      }
+      if (cache && pools == &cache->pools) {
+        cache->pool_caps = caps;
+        cache->pool_shadows = shadows;
+      }
     }
   } else {
-    // The paper's global queue: a task for every path of the frame, all at once.
+    // The paper's global queue: a task for every path of the frame, all at once (never kept:
+    // and no kept pools beside it).
+    if (cache) cache->drop_pools();
     const uint64_t per_task = PathPool::state_bytes(shadows);
     const uint64_t need = total * per_task;
     const uint64_t free_b = DeviceMemory::free_bytes();
@@ -181,20 +297,21 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
           "--width/--height, or use --strategy wavefront (memory bounded by --paths-in-flight)",
           s.width, s.height, s.spp, total, per_task, need / 1e9, info.name, free_b / 1e9,
           total > 0xFFFFFFFFull ? " (and more than 2^32 - 1 tasks cannot be indexed)" : ""));
-    pools.push_back(std::make_unique<PathPool>(total, shadows, "the paper-queue global task queue",
-                                               "--spp or --width/--height"));
+    own_pools.push_back(std::make_unique<PathPool>(total, shadows, "the paper-queue global task queue",
+                                                   "--spp or --width/--height"));
     warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
   }
 
   occupancy = s.strategy == Strategy::Pixel ? pixel_occupancy(g) : PixelOccupancy{};
-  pool_stream_ids.push_back(stream.s);
-  for (const auto& pool : pools) pool_ptrs.push_back(pool.get());
-  for (const auto& ps : pool_streams) pool_stream_ids.push_back(ps->s);
+  pool_stream_ids.push_back(stream);
+  for (const auto& pool : *pools) pool_ptrs.push_back(pool.get());
+  for (const auto& ps : *pool_streams) pool_stream_ids.push_back(ps->s);
+  pool_count = pools->size();
 }
 
 FrameResult RenderSetup::run_frame(uint64_t n, bool variance) {
   if (settings.strategy == Strategy::Pixel)
-    return run_pixel(launch, stream.s, g, config, spp, n, fb.view, variance, settings.precision, settings.watertight,
+    return run_pixel(launch, stream, g, config, spp, n, fb.view, variance, settings.precision, settings.watertight,
                      pixel_counters, occupancy.min_blocks);
   return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, spp, n, fb.view,
                    variance);
@@ -214,12 +331,12 @@ TimedFrame run_timed_frame(RenderSetup& su, Film& film, DeviceFilm* keep) {
   DeviceMemory& mem = DeviceMemory::instance();
   // A kept film's later renders add to what is there: the first one warmed up.
   if (su.first_use) {
-    su.fb.clear(su.stream.s);
+    su.fb.clear(su.stream);
     su.run_frame(su.warmup_total, film.has_variance());
-    PB_CUDA_CHECK(cudaStreamSynchronize(su.stream.s));
+    PB_CUDA_CHECK(cudaStreamSynchronize(su.stream));
     mem.sample();
     su.launch.clear();
-    su.fb.clear(su.stream.s);
+    su.fb.clear(su.stream);
   }
   if (keep) {
     DeviceFilm::Impl& k = keep->impl();
@@ -230,16 +347,19 @@ TimedFrame run_timed_frame(RenderSetup& su, Film& film, DeviceFilm* keep) {
   }
 
   TimedFrame t;
-  ScopedEvent ev0, ev1;
-  PB_CUDA_CHECK(cudaStreamSynchronize(su.stream.s));
+  std::unique_ptr<ScopedEvent> own0, own1;  // without a cache
+  if (!su.cache) own0 = std::make_unique<ScopedEvent>(), own1 = std::make_unique<ScopedEvent>();
+  const cudaEvent_t e0 = su.cache ? su.cache->ev0.e : own0->e, e1 = su.cache ? su.cache->ev1.e : own1->e;
+  PB_CUDA_CHECK(cudaStreamSynchronize(su.stream));
   const auto t0 = std::chrono::steady_clock::now();
-  PB_CUDA_CHECK(cudaEventRecord(ev0.e, su.stream.s));
+  PB_CUDA_CHECK(cudaEventRecord(e0, su.stream));
   t.result = su.run_frame(su.total, film.has_variance());
-  PB_CUDA_CHECK(cudaEventRecord(ev1.e, su.stream.s));
-  PB_CUDA_CHECK(cudaEventSynchronize(ev1.e));
+  PB_CUDA_CHECK(cudaEventRecord(e1, su.stream));
+  PB_CUDA_CHECK(cudaEventSynchronize(e1));
   const auto t1 = std::chrono::steady_clock::now();
-  mem.sample();
-  PB_CUDA_CHECK(cudaEventElapsedTime(&t.device_ms, ev0.e, ev1.e));
+  // A kept film's later renders: its first render's measurement stands (render()).
+  if (su.first_use || !su.cache) mem.sample();
+  PB_CUDA_CHECK(cudaEventElapsedTime(&t.device_ms, e0, e1));
   t.seconds = std::chrono::duration<double>(t1 - t0).count();
 
   t.download_seconds = keep ? 0.0 : download_film(su.fb, film);
@@ -273,7 +393,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
               {"compute_capability", fmt::format("{}.{}", info.compute_major, info.compute_minor)},
               {"multiprocessors", info.multiprocessors},
               {"memory_bytes", info.total_memory},
-              {"driver_version", kernel_driver_version()},
+              {"driver_version", su.driver},
               {"driver_cuda_version", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10)},
               {"cuda_runtime_version", fmt::format("{}.{}", info.runtime_version / 1000, (info.runtime_version % 1000) / 10)},
               {"cuda_architectures_built", PATHBENCH_CUDA_ARCHS}};
@@ -303,7 +423,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
     x["pool_device_bytes"] = r.pool_bytes;
     x["iterations"] = r.iterations;
     x["counter_rounds"] = r.counter_rounds;  // work_chunks.cuh: the stages' last rounds from a counter
-    x["pools"] = su.pools.size();  // path_pool.cuh: run_pools, each on a stream of its own
+    x["pools"] = su.pool_count;  // path_pool.cuh: run_pools, each on a stream of its own
   }
   if (settings.strategy == Strategy::PaperQueue) {
     x["bytes_per_task"] = r.state_bytes_per_path;  // the queues are the compacted state buffers themselves
@@ -327,7 +447,8 @@ void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSett
                  RunReport& report, bool profile, DeviceFilm* keep) {
   if (film.width() != settings.width || film.height() != settings.height)
     throw std::logic_error("film size does not match the settings");
-  RenderSetup setup(scene, gpu_scene, settings, film, profile, keep);
+  CacheLease lease;  // held until the report is filled
+  RenderSetup setup(scene, gpu_scene, settings, film, profile, keep, lease.cache);
   const TimedFrame frame = run_timed_frame(setup, film, keep);
   fill_report(setup, frame, film, profile, keep != nullptr, report);
 }

@@ -13,6 +13,7 @@
 
 #include "gpu_reduce.h"
 #include "mpi_detail.h"
+#include "pathbench/common/errors.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/world.h"
@@ -34,6 +35,9 @@ struct Comm {
   MPI_Comm gpus = MPI_COMM_NULL;  // the GPU ranks
   ncclComm_t nccl = nullptr;
   cudaStream_t stream = nullptr;
+  // The banded reduction's receive buffer on the root (sums, counts, variance sums).
+  char* recv = nullptr;
+  size_t recv_bytes = 0;
 };
 std::map<std::string, Comm>& comms() {
   static std::map<std::string, Comm> m;
@@ -60,7 +64,9 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index) {
   char bus[64] = "-";
   if (gpu && gpu_index >= 0) cuda_check(cudaDeviceGetPCIBusId(bus, sizeof bus, gpu_index), "cudaDeviceGetPCIBusId");
   const char* env = std::getenv("PATHBENCH_FILM_REDUCE");
-  const std::string mine = fmt::format("{} {}/{} {}", gpu ? 1 : 0, w.host(), bus, env ? env : "");
+  const char* bands_env = std::getenv("PATHBENCH_REDUCE_BANDS");
+  const std::string mine =
+      fmt::format("{} {}/{} {}|{}", gpu ? 1 : 0, w.host(), bus, env ? env : "", bands_env ? bands_env : "");
   const std::vector<std::string> all = w.all(mine);
   std::set<std::string> devices;
   int gpus = 0;
@@ -71,7 +77,16 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index) {
     ++gpus;
     shared |= !devices.insert(all[i].substr(2, all[i].rfind(' ') - 2)).second;
   }
-  const std::string asked = all[0].substr(all[0].rfind(' ') + 1);  // rank 0's PATHBENCH_FILM_REDUCE
+  const std::string last = all[0].substr(all[0].rfind(' ') + 1);  // rank 0's "PATHBENCH_FILM_REDUCE|..._BANDS"
+  const std::string asked = last.substr(0, last.find('|'));
+  const std::string bands = last.substr(last.find('|') + 1);
+  if (!bands.empty() && bands != "auto") {
+    char* end = nullptr;
+    const long n = std::strtol(bands.c_str(), &end, 10);
+    if (*end != '\0' || n < 1 || n > 64)
+      throw InputError(fmt::format("PATHBENCH_REDUCE_BANDS='{}': expected auto or a band count 1..64", bands));
+    r.bands_asked = int(n);
+  }
   if (gpus < 2) r.why = "fewer than two GPU ranks";
   else if (asked == "mpi") r.why = "PATHBENCH_FILM_REDUCE=mpi";
   else if (shared) r.why = "two GPU ranks share a GPU (NCCL needs one rank per GPU): MPI";
@@ -120,10 +135,83 @@ void nccl_reduce(gpu::DeviceFilm& film) {
 }
 }  // namespace
 
-void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film) {
+// Where the banded reduction's receive buffer holds a film of `pixels` (variance or not).
+struct RecvLayout {
+  size_t sums, counts, sum_sq, bytes;
+  RecvLayout(uint64_t pixels, bool variance) {
+    sums = 0;
+    counts = pixels * 3 * sizeof(int64_t);
+    sum_sq = (counts + pixels * sizeof(uint32_t) + 15) / 16 * 16;
+    bytes = sum_sq + (variance ? pixels * 3 * sizeof(double) : 0);
+  }
+};
+
+void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film, bool band_root) {
   if (!r.nccl || !current || !film) return;
   (void)film->max_abs_sum();
   nccl_reduce(*film);  // zeros onto zeros: the root's film stays cleared
+  if (!band_root) return;
+  const gpu::DeviceFilm::Arrays a = film->arrays();
+  const RecvLayout at(a.pixels, a.sum_sq != nullptr);
+  if (current->recv_bytes >= at.bytes) return;
+  if (current->recv) cuda_check(cudaFree(current->recv), "cudaFree (the banded reduction's receive buffer)");
+  current->recv = nullptr;
+  current->recv_bytes = 0;
+  void* p = nullptr;
+  cuda_check(cudaMalloc(&p, at.bytes), "cudaMalloc (the banded reduction's receive buffer: a second film)");
+  current->recv = static_cast<char*>(p);
+  current->recv_bytes = at.bytes;
+}
+
+void reduce_gpu_band(const GpuReduction& r, gpu::DeviceFilm* film, Film& host, bool root, uint32_t first_row,
+                     uint32_t rows) {
+  if (!r.nccl || !current || !film || rows == 0) return;
+  const gpu::DeviceFilm::Arrays a = film->arrays();
+  const RecvLayout at(a.pixels, a.sum_sq != nullptr);
+  if (uint64_t(first_row) + rows > host.height() || a.pixels != host.pixels())
+    throw std::logic_error("reduce_gpu_band: the band lies outside the film");
+  if (root && current->recv_bytes < at.bytes)
+    throw std::logic_error("reduce_gpu_band: no receive buffer (warm_gpu_reduction with band_root)");
+  const size_t px0 = size_t(first_row) * host.width(), px = size_t(rows) * host.width();
+  auto* sums = static_cast<int64_t*>(a.sums) + px0 * 3;
+  auto* counts = static_cast<uint32_t*>(a.counts) + px0;
+  auto* sq = a.sum_sq ? static_cast<double*>(a.sum_sq) + px0 * 3 : nullptr;
+  // The root receives into its second film (out of place); the others' receive buffers are unused.
+  auto* rsums = root ? reinterpret_cast<int64_t*>(current->recv + at.sums) + px0 * 3 : sums;
+  auto* rcounts = root ? reinterpret_cast<uint32_t*>(current->recv + at.counts) + px0 : counts;
+  auto* rsq = root && sq ? reinterpret_cast<double*>(current->recv + at.sum_sq) + px0 * 3 : sq;
+  cudaStream_t st = current->stream;
+  nccl_check(ncclGroupStart(), "ncclGroupStart");
+  nccl_check(ncclReduce(sums, rsums, px * 3, ncclInt64, ncclSum, 0, current->nccl, st), "ncclReduce (a band's sums)");
+  nccl_check(ncclReduce(counts, rcounts, px, ncclUint32, ncclSum, 0, current->nccl, st), "ncclReduce (a band's counts)");
+  if (sq) nccl_check(ncclReduce(sq, rsq, px * 3, ncclFloat64, ncclSum, 0, current->nccl, st), "ncclReduce (a band's variance sums)");
+  nccl_check(ncclGroupEnd(), "ncclGroupEnd");
+  if (!root) return;
+  cuda_check(cudaMemcpyAsync(host.raw_sums().data() + px0 * 3, rsums, px * 3 * sizeof(int64_t), cudaMemcpyDeviceToHost, st),
+             "cudaMemcpyAsync (a band's sums)");
+  cuda_check(cudaMemcpyAsync(host.counts().data() + px0, rcounts, px * sizeof(uint32_t), cudaMemcpyDeviceToHost, st),
+             "cudaMemcpyAsync (a band's counts)");
+  if (sq && host.has_variance())
+    cuda_check(cudaMemcpyAsync(host.raw_sum_sq().data() + px0 * 3, rsq, px * 3 * sizeof(double), cudaMemcpyDeviceToHost, st),
+               "cudaMemcpyAsync (a band's variance sums)");
+}
+
+bool finish_gpu_bands(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+                      double& wait_seconds) {
+  using Clock = std::chrono::steady_clock;
+  bound_seconds = wait_seconds = 0;
+  if (!r.nccl || !current) return false;
+  // The bound first (its kernel runs beside the last band's reduction, on another stream):
+  // the banded sums were added unchecked, so they count only where no partial sum can overflow.
+  const auto t0 = Clock::now();
+  uint64_t largest = film ? film->max_abs_sum() : 0;
+  std::vector<uint64_t> all(size_t(w.size()), 0);
+  MPI_Allgather(&largest, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
+  const auto t1 = Clock::now();
+  bound_seconds = std::chrono::duration<double>(t1 - t0).count();
+  if (film) cuda_check(cudaStreamSynchronize(current->stream), "cudaStreamSynchronize (the bands' reductions)");
+  wait_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+  return sums_cannot_overflow(all);
 }
 
 bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,

@@ -167,7 +167,13 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // A GPU rank that downloads a film it keeps (NCCL's root, or every GPU rank without NCCL)
   // downloads into page-locked memory.
   PinnedFilm pinned(film, s.device == Device::Gpu && (!gred.nccl || w.rank() == gred.root));
-  on_every_rank([&] { warm_gpu_reduction(gred, tracer->device_film()); });
+  // Overlap: a static split over GPU ranks alone traces in bands of rows and reduces each
+  // band on NCCL's stream while the next traces (gpu_reduce.h: reduction_bands); 1: at the end.
+  // (The count from rank 0's share, the largest: the same on every rank.)
+  const uint64_t rank_samples = uint64_t(s.width) * s.height * share_of(0, uint32_t(w.size()), s.spp).count;
+  const uint32_t bands = gred.nccl && !cpu_ranks && balance == Balance::Static
+                             ? reduction_bands(rank_samples, s.height, gred.bands_asked) : 1;
+  on_every_rank([&] { warm_gpu_reduction(gred, tracer->device_film(), bands > 1 && w.rank() == gred.root); });
   // Dynamic balancing: a rank's probe chunk measures its rate: ~2 M samples fill a GPU (an
   // H100 runs ~270 k threads at once), 64 per thread keep a CPU rank's short. Each rank
   // traces one before the frame's clock starts (as it warms up), and every rank's rate
@@ -207,7 +213,21 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     std::optional<SampleDispenser> dispenser;
     if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
     try {
-      if (balance == Balance::Static) {
+      if (balance == Balance::Static && bands > 1) {
+        // Every GPU rank starts every band's reduction, in order: a rank with no samples, or
+        // whose tracer failed (the agreement below then ends the frame), too, so that no
+        // rank's NCCL stream waits for a band that never comes.
+        const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
+        for (uint32_t k = 0; k < bands; ++k) {
+          const auto [first_row, rows] = band_rows(k, bands, s.height);
+          try {
+            if (!failed.failed() && share.count && rows) trace({first_row, rows, share.first, share.count}), ++chunks;
+          } catch (...) {
+            failed = failure_of(std::current_exception(), w.rank());
+          }
+          reduce_gpu_band(gred, tracer->device_film(), film, w.rank() == gred.root, first_row, rows);
+        }
+      } else if (balance == Balance::Static) {
         const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
         if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
@@ -235,10 +255,13 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   double bound_seconds = 0, nccl_seconds = 0, download_seconds = 0, mpi_seconds = 0;
   bool by_nccl = false;
   on_every_rank([&] {
-    // GPU ranks: added on the GPUs onto the lowest GPU rank, which alone downloads the sum.
-    by_nccl = reduce_gpu_films(w, gred, tracer->device_film(), bound_seconds, nccl_seconds);
+    // GPU ranks: added on the GPUs onto the lowest GPU rank, which alone downloads the sum
+    // (banded: the bands' reductions and downloads started as they were traced: the rest of them).
+    bool downloaded = false;
+    if (bands > 1) downloaded = by_nccl = finish_gpu_bands(w, gred, tracer->device_film(), bound_seconds, nccl_seconds);
+    else by_nccl = reduce_gpu_films(w, gred, tracer->device_film(), bound_seconds, nccl_seconds);
     const Clock::time_point d0 = Clock::now();
-    if (!by_nccl || w.rank() == gred.root) tracer->finish(film, mine);  // GPU ranks: the download
+    if (!by_nccl || (w.rank() == gred.root && !downloaded)) tracer->finish(film, mine);  // GPU ranks: the download
     download_seconds = since(d0);
     const Clock::time_point m0 = Clock::now();
     if (by_nccl && !mpi_after_nccl) return;
@@ -282,6 +305,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     if (balance == Balance::Dynamic) report.extra["ranks"]["chunks_granted"] = granted;
     report.extra["ranks"]["reduction"] = {
         {"gpu_ranks", by_nccl ? "nccl" : "mpi"}, {"why", gred.why},
+        {"bands", bands},  // > 1: reduced band by band while the next band traced (gpu_reduce.h)
         {"nccl_version", gred.nccl_version.empty() ? nlohmann::json(nullptr) : nlohmann::json(gred.nccl_version)},
         {"share_of_frame", frame_seconds > 0 ? reduce_seconds / frame_seconds : 0.0}};
     check_discarded(scene, settings, report);

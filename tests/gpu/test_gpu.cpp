@@ -268,6 +268,43 @@ TEST(DeviceFilm, BlocksAddUpToTheWholeFrame) {
   }
 }
 
+// gpu::render keeps its per-call setup for the process's next render (render.cu's
+// RenderCache, issue 30): equal chunks of a kept film reuse the kept wavefront pools,
+// renders of other strategies in between release them, and every film stays the one
+// render's byte for byte (and the report's pool count the pools that ran).
+TEST(DeviceFilm, KeptSetupAcrossRendersGivesTheSameFilms) {
+  PB_REQUIRE_GPU();
+  const Scene scene = load_scene("paper-cornell");
+  const GpuScene gpu_scene(scene);
+  for (Strategy strategy : {Strategy::Wavefront, Strategy::Pixel}) {
+    const RenderSettings s = small_settings(strategy, 48, 16);
+    const Film whole = render_gpu(scene, gpu_scene, s);
+    for (int round = 0; round < 2; ++round) {
+      Film kept(s.width, s.height, false);
+      kept.begin(s.spp, scene.max_emission());
+      DeviceFilm device_film;
+      // Four equal blocks (24 rows x 8 samples): the same pools each time; a render of the
+      // other strategy between the second and third releases them.
+      const uint32_t blocks[][4] = {{0, 24, 0, 8}, {24, 24, 0, 8}, {0, 24, 8, 8}, {24, 24, 8, 8}};
+      int k = 0;
+      for (const auto& b : blocks) {
+        if (k++ == 2) {
+          RenderSettings other = small_settings(strategy == Strategy::Pixel ? Strategy::Wavefront : Strategy::Pixel, 16, 4);
+          (void)render_gpu(scene, gpu_scene, other);
+        }
+        RenderSettings c = s;
+        c.first_row = b[0], c.row_count = b[1], c.first_sample = b[2], c.sample_count = b[3];
+        RunReport r;
+        render(scene, gpu_scene, c, kept, r, false, &device_film);
+        if (strategy == Strategy::Wavefront) EXPECT_GE(r.extra.value("pools", 0), 1);
+      }
+      device_film.download(kept);
+      expect_identical(whole, kept, to_string(strategy));
+      EXPECT_EQ(whole.counts(), kept.counts());
+    }
+  }
+}
+
 // What run/'s NCCL reduction reads of a device film (issue 30): its arrays on the device,
 // and the largest |sum|, the same as the downloaded film's.
 TEST(DeviceFilm, ArraysAndLargestSum) {

@@ -16,6 +16,10 @@
 # gpu_shared      (CUDA builds; skipped without a GPU) 3 GPU ranks on the visible GPUs, more
 #                 ranks than GPUs where there are fewer than 3: the one-GPU image; the report
 #                 says how the GPU ranks' films were reduced (NCCL or MPI, and why)
+# gpu2_bands      (CUDA builds; skipped without a GPU) 2 GPU ranks with PATHBENCH_REDUCE_BANDS=4
+#                 (on 2 GPUs with NCCL: the film reduced band by band while the next band
+#                 traces), with 3 (uneven rows) and 64 (more bands than rows: one a row), and
+#                 a bad count refused (exit 2): the one-GPU image byte for byte
 # tcp             as between nodes: MPI's TCP transport alone (--mca btl self,tcp, no shared
 #                 memory), static and dynamic: the one-process image byte for byte
 # tcp_killed_rank a rank SIGKILLed over TCP alone: the run ends within 30 s with a message
@@ -84,6 +88,25 @@ case $case_name in
     cmp -s gpu.pfm x.pfm || fail "3 GPU ranks: x.pfm differs from the one-GPU image"
     [ "$(film_hash gpu.json)" = "$(film_hash x.json)" ] || fail "3 GPU ranks: film_hash differs"
     grep -q '"gpu_ranks": "\(nccl\|mpi\)"' x.json || fail "the report does not say how the films were reduced" ;;
+  gpu2_bands)
+    bframe="render --quiet --width 64 --height 50 --bounces 2 --spp 24 --device gpu"
+    "$pb" $bframe --out gpu.pfm --report gpu.json 2>gpu.err || { cat gpu.err; echo "no usable GPU: skipped"; exit 77; }
+    for bands in 4 3 64; do
+      export PATHBENCH_REDUCE_BANDS=$bands
+      run -x PATHBENCH_REDUCE_BANDS -np 2 "$pb" $bframe --out b$bands.pfm --report b$bands.json
+      [ "$status" = 0 ] || { cat err.txt >&2; fail "PATHBENCH_REDUCE_BANDS=$bands: status $status"; }
+      cmp -s gpu.pfm b$bands.pfm || fail "PATHBENCH_REDUCE_BANDS=$bands: the image differs from the one-GPU image"
+      [ "$(film_hash gpu.json)" = "$(film_hash b$bands.json)" ] || fail "PATHBENCH_REDUCE_BANDS=$bands: film_hash differs"
+      # Through NCCL (2 GPUs) the report names the bands, at most one a row; through MPI one.
+      if grep -q '"gpu_ranks": "nccl"' b$bands.json; then
+        want=$bands; [ $bands -gt 50 ] && want=50
+        grep -q "\"bands\": $want," b$bands.json || fail "PATHBENCH_REDUCE_BANDS=$bands: the report does not say $want bands"
+      fi
+    done
+    export PATHBENCH_REDUCE_BANDS=lots
+    run -x PATHBENCH_REDUCE_BANDS -np 2 "$pb" $bframe --out bad.pfm
+    unset PATHBENCH_REDUCE_BANDS
+    if grep -q '"gpu_ranks": "nccl"' b4.json; then refused 2 "PATHBENCH_REDUCE_BANDS='lots'" bad.pfm; fi ;;
   np2|np3)
     n=${case_name#np}
     one

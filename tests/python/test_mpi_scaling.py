@@ -120,3 +120,49 @@ def test_gpu_counts():
     assert mpi_scaling.gpu_counts(4) == [1, 2, 4]
     assert mpi_scaling.gpu_counts(6) == [1, 2, 4, 6]
     assert mpi_scaling.gpu_counts(8) == [1, 2, 4, 8]
+
+
+def _report(seconds, ranks=None, reduce=None, bands=None, film="fnv1a64:1"):
+    rep = {"seconds": seconds, "film_download_seconds": 0.0, "film_hash": film}
+    if ranks:
+        rep["ranks"] = {"frame_seconds": seconds, "reduce_seconds": reduce,
+                        "reduction": {"share_of_frame": reduce / seconds, "bands": bands}}
+    return rep
+
+
+def test_ab_summary_rounds_ratios_and_hashes(tmp_path):
+    """tools/mpi_scaling_ab.py: per-round ratios base / arm, medians, and one film hash per
+    frame (or the differing hashes named)."""
+    import mpi_scaling_ab
+
+    cache, bands = tmp_path / "cache", tmp_path / "bands"
+    cache.mkdir()
+    bands.mkdir()
+    for i, (g, on, off) in enumerate([(0.010, 0.0098, 0.0104), (0.011, 0.0105, 0.0110), (0.012, 0.0130, 0.0125)], 1):
+        (cache / f"gpu-256-{i}.json").write_text(json.dumps(_report(g)))
+        (cache / f"on-256-{i}.json").write_text(json.dumps(_report(on, 2, 0.0001, 1)))
+        (cache / f"off-256-{i}.json").write_text(json.dumps(_report(off, 2, 0.0001, 1)))
+    for i in (1, 2):
+        (bands / f"b1-2048-{i}.json").write_text(json.dumps(_report(0.464, 2, 0.0028, 1)))
+        (bands / f"bauto-2048-{i}.json").write_text(json.dumps(_report(0.462, 2, 0.0005, 8,
+                                                                        film="fnv1a64:2" if i == 2 else "fnv1a64:1")))
+    (bands / "notes.txt").write_text("ignored")
+    assert mpi_scaling_ab.main([str(tmp_path)]) == 0
+    doc = json.loads((tmp_path / "ab.json").read_text())
+    on = next(r for r in doc["cache"]["rows"] if r["arm"] == "on")
+    assert on["round_ratios"] == pytest.approx([0.010 / 0.0098, 0.011 / 0.0105, 0.012 / 0.0130])
+    assert on["ratio"]["median"] == pytest.approx(0.010 / 0.0098)  # of 1.020, 1.048, 0.923
+    assert on["seconds"]["median"] == pytest.approx(0.0105)
+    gpu = next(r for r in doc["cache"]["rows"] if r["arm"] == "gpu")
+    assert "round_ratios" not in gpu and gpu["reduce_seconds"] == {}
+    auto = next(r for r in doc["bands"]["rows"] if r["arm"] == "bauto")
+    assert auto["bands"] == [8] and auto["reduce_share"]["median"] == pytest.approx(0.0005 / 0.462)
+    assert doc["cache"]["film_hashes_per_width"] == {"256": ["fnv1a64:1"]}
+    assert doc["bands"]["film_hashes_per_width"]["2048"] == ["fnv1a64:1", "fnv1a64:2"]
+
+
+def test_ab_summary_refuses_an_empty_folder(tmp_path, capsys):
+    import mpi_scaling_ab
+
+    assert mpi_scaling_ab.main([str(tmp_path)]) == 2
+    assert "neither cache/ nor bands/" in capsys.readouterr().err
