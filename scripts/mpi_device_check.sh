@@ -88,23 +88,35 @@ if has check; then
   done
   rm -f "$OUT"/*.pfm
 fi
-if has hybrid; then
-  # Interleaved rounds: one GPU process, then the hybrid (1 GPU + 1 CPU rank), same frame.
-  # Both timed from the frame's start to the film on the host: the GPU's `seconds` (host
-  # clock around its frame) plus its film download, against the hybrid's frame_seconds
-  # (common start to the film reduced on rank 0).
-  mkdir -p "$OUT/hybrid"
+# Interleaved rounds at 256x256x800 (REPS rounds) and 2048x2048x1024 (REPS_BIG): one GPU
+# process (DIR/gpu-<width>-<i>.json), then for each arm the hybrid (1 GPU + 1 CPU rank, MPMD,
+# dynamic) with PATHBENCH_GPU_RENDER_CACHE=1 (arms hy, on) or 0 (off) on both ranks
+# (DIR/<arm>-<width>-<i>.json); each image against the GPU's, byte for byte.
+hybrid_rounds() {  # DIR REPS REPS_BIG ARM...
+  local dir=$1 reps=$2 big=$3; shift 3
+  local arms="$*" frame f n i arm
+  mkdir -p "$dir"
   for frame in "256 256 800" "2048 2048 1024"; do
     set -- $frame
     f="render --quiet --width $1 --height $2 --spp $3 --bounces 2"
-    for i in $(seq 1 ${REPS:-5}); do
-      $PB $f --device gpu --out "$OUT/g.pfm" --report "$OUT/hybrid/gpu-$1-$i.json"
-      mpi -np 1 $PB $f --device gpu --out "$OUT/h.pfm" --report "$OUT/hybrid/hy-$1-$i.json" : \
-          -np 1 $PB $f --device cpu --out "$OUT/h.pfm" --report "$OUT/hybrid/hy-$1-$i.json"
-      same "$OUT/g.pfm" "$OUT/h.pfm" "$1x$2x$3 round $i: hybrid vs one GPU"
+    n=$reps; [ "$1" = 2048 ] && n=$big
+    for i in $(seq 1 $n); do
+      $PB $f --device gpu --out "$OUT/g.pfm" --report "$dir/gpu-$1-$i.json"
+      for arm in $arms; do
+        PATHBENCH_GPU_RENDER_CACHE=$([ $arm = off ] && echo 0 || echo 1) mpi -x PATHBENCH_GPU_RENDER_CACHE \
+            -np 1 $PB $f --device gpu --out "$OUT/h.pfm" --report "$dir/$arm-$1-$i.json" : \
+            -np 1 $PB $f --device cpu --out "$OUT/h.pfm" --report "$dir/$arm-$1-$i.json"
+        same "$OUT/g.pfm" "$OUT/h.pfm" "$1x$2x$3 round $i: hybrid ($arm) vs one GPU"
+      done
     done
   done
   rm -f "$OUT"/*.pfm
+}
+if has hybrid; then
+  # Both timed from the frame's start to the film on the host: the GPU's `seconds` (host
+  # clock around its frame) plus its film download, against the hybrid's frame_seconds
+  # (common start to the film reduced on rank 0).
+  hybrid_rounds "$OUT/hybrid" "${REPS:-5}" "${REPS:-5}" hy
   python3 tools/hybrid_timing.py "$OUT/hybrid" | tee "$OUT/hybrid.md" | tee -a "$OUT/summary.txt"
 fi
 if has bench; then
@@ -144,25 +156,8 @@ if has reduce; then
   done
 fi
 if has cache; then
-  # Interleaved rounds at each frame: one GPU process, the hybrid (1 GPU + 1 CPU rank, MPMD)
-  # with gpu::render's kept setup, and without it (PATHBENCH_GPU_RENDER_CACHE=0, both ranks).
-  mkdir -p "$OUT/ab/cache"
-  for frame in "256 256 800" "2048 2048 1024"; do
-    set -- $frame
-    f="render --quiet --width $1 --height $2 --spp $3 --bounces 2"
-    reps=${CACHE_REPS:-5}; [ "$1" = 2048 ] && reps=${CACHE_REPS_BIG:-3}
-    for i in $(seq 1 $reps); do
-      $PB $f --device gpu --out "$OUT/g.pfm" --report "$OUT/ab/cache/gpu-$1-$i.json"
-      for arm in on off; do
-        c=1; [ $arm = off ] && c=0
-        PATHBENCH_GPU_RENDER_CACHE=$c mpi -x PATHBENCH_GPU_RENDER_CACHE -np 1 $PB $f --device gpu --out "$OUT/h.pfm" \
-            --report "$OUT/ab/cache/$arm-$1-$i.json" : -np 1 $PB $f --device cpu --out "$OUT/h.pfm" \
-            --report "$OUT/ab/cache/$arm-$1-$i.json"
-        same "$OUT/g.pfm" "$OUT/h.pfm" "$1x$2x$3 round $i: hybrid (cache $arm) vs one GPU"
-      done
-    done
-  done
-  rm -f "$OUT"/*.pfm
+  # The hybrid with gpu::render's kept setup (on) and without it (off), against one GPU.
+  hybrid_rounds "$OUT/ab/cache" "${CACHE_REPS:-5}" "${CACHE_REPS_BIG:-3}" on off
 fi
 if has bands; then
   # 2 GPU ranks: the film reduced at the end (1 band) against band by band while tracing

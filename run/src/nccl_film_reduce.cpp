@@ -135,6 +135,17 @@ void nccl_reduce(gpu::DeviceFilm& film) {
 }
 }  // namespace
 
+namespace {
+// The overflow bound (collective over every rank): every partial sum of the GPU ranks' films
+// stays below the sum of the ranks' largest |sums|; true where that is below 2^63 (every rank
+// sees the same values, so all agree).
+bool films_cannot_overflow(World& w, gpu::DeviceFilm* film) {
+  const uint64_t largest = film ? film->max_abs_sum() : 0;
+  std::vector<uint64_t> all(size_t(w.size()), 0);
+  MPI_Allgather(&largest, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
+  return sums_cannot_overflow(all);
+}
+
 // Where the banded reduction's receive buffer holds a film of `pixels` (variance or not).
 struct RecvLayout {
   size_t sums, counts, sum_sq, bytes;
@@ -145,6 +156,7 @@ struct RecvLayout {
     bytes = sum_sq + (variance ? pixels * 3 * sizeof(double) : 0);
   }
 };
+}  // namespace
 
 void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film, bool band_root) {
   if (!r.nccl || !current || !film) return;
@@ -204,14 +216,12 @@ bool finish_gpu_bands(World& w, const GpuReduction& r, gpu::DeviceFilm* film, do
   // The bound first (its kernel runs beside the last band's reduction, on another stream):
   // the banded sums were added unchecked, so they count only where no partial sum can overflow.
   const auto t0 = Clock::now();
-  uint64_t largest = film ? film->max_abs_sum() : 0;
-  std::vector<uint64_t> all(size_t(w.size()), 0);
-  MPI_Allgather(&largest, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
+  const bool safe = films_cannot_overflow(w, film);
   const auto t1 = Clock::now();
   bound_seconds = std::chrono::duration<double>(t1 - t0).count();
   if (film) cuda_check(cudaStreamSynchronize(current->stream), "cudaStreamSynchronize (the bands' reductions)");
   wait_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
-  return sums_cannot_overflow(all);
+  return safe;
 }
 
 bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
@@ -219,13 +229,10 @@ bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, do
   using Clock = std::chrono::steady_clock;
   bound_seconds = nccl_seconds = 0;
   if (!r.nccl || !current) return false;
-  // The overflow bound: every partial sum stays below the sum of the ranks' largest |sums|.
   const auto t0 = Clock::now();
-  uint64_t largest = film ? film->max_abs_sum() : 0;
-  std::vector<uint64_t> all(size_t(w.size()), 0);
-  MPI_Allgather(&largest, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
+  const bool safe = films_cannot_overflow(w, film);
   bound_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (!sums_cannot_overflow(all)) return false;  // every rank sees the same values
+  if (!safe) return false;
   if (!film) return true;
   const auto t1 = Clock::now();
   // In place on the root (send = receive buffer); the others' receive buffers are unused.
