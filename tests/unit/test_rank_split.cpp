@@ -13,6 +13,7 @@
 #include "pathbench/run/ranks_report.h"
 #include "pathbench/run/run.h"
 #include "pathbench/run/world.h"
+#include "../../run/src/gpu_reduce.h"  // reduction_bands, band_rows (run/ private)
 
 namespace pb {
 namespace {
@@ -254,3 +255,37 @@ TEST(RankSplit, EfficiencyNeverAboveOneWhenARankStartedEarly) {
 
 }  // namespace
 }  // namespace pb
+
+// The overlapped reduction's bands (gpu_reduce.h, issue 30): one band below kBandSamples a
+// rank (a band costs a tracer call: ~0.33 ms on an H100), then one per kBandSamples up to
+// kMaxBands; PATHBENCH_REDUCE_BANDS fixes the count; never more bands than rows; the bands
+// cover every row once, in order, as evenly as the rows go.
+TEST(ReductionBands, CountFollowsTheRanksSamples) {
+  using pb::run::reduction_bands;
+  const uint64_t b = pb::run::kBandSamples;
+  EXPECT_EQ(reduction_bands(256ull * 256 * 400, 256, 0), 1u);  // 256x256x800 over 2 ranks: one band
+  EXPECT_EQ(reduction_bands(b - 1, 256, 0), 1u);
+  EXPECT_EQ(reduction_bands(3 * b, 256, 0), 3u);
+  EXPECT_EQ(reduction_bands(2048ull * 2048 * 512, 2048, 0), pb::run::kMaxBands);  // 2048x2048x1024 over 2
+  EXPECT_EQ(reduction_bands(100 * b, 5, 0), 5u) << "at most one band a row";
+  EXPECT_EQ(reduction_bands(0, 256, 4), 4u) << "asked for";
+  EXPECT_EQ(reduction_bands(b * 100, 50, 64), 50u);
+  EXPECT_EQ(reduction_bands(b * 100, 256, 1), 1u);
+}
+
+TEST(ReductionBands, BandsCoverEveryRowOnce) {
+  for (uint32_t rows : {1u, 7u, 50u, 256u, 2048u})
+    for (uint32_t bands = 1; bands <= std::min(rows, 64u); ++bands) {
+      uint32_t next = 0, smallest = rows, largest = 0;
+      for (uint32_t k = 0; k < bands; ++k) {
+        const auto [first, count] = pb::run::band_rows(k, bands, rows);
+        EXPECT_EQ(first, next) << rows << " rows, band " << k << " of " << bands;
+        next = first + count;
+        smallest = std::min(smallest, count);
+        largest = std::max(largest, count);
+      }
+      EXPECT_EQ(next, rows);
+      EXPECT_LE(largest - smallest, 1u);
+      EXPECT_GE(smallest, 1u);
+    }
+}
