@@ -10,7 +10,11 @@
 // Traversal follows the paper: a stack of "node groups" (the base index of a node's inner
 // children + a mask of the ones the ray hit, ordered by the ray's octant so that popping
 // the highest bit takes the child nearest the ray's origin first), the hit leaves'
-// triangles tested as soon as the node is (one bit each in the low 24 bits).
+// triangles tested as soon as the node is (one bit each in the low 24 bits). The stack is
+// a short one in registers (WideShortStack: the kWideShortStack most recent groups, as
+// Vaidyanathan, Woop & Benthin, HPG 2019, keep theirs), over a backing array in local
+// memory for the older ones: nothing is dropped and no restart is needed, so the visit
+// order, and every hit, is that of a plain stack.
 #include <cstdint>
 #include <cstring>
 
@@ -31,6 +35,7 @@ namespace pb::bvh {
 constexpr uint32_t kWideMaxChildren = 8;
 constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
 constexpr int kWideStackSize = 64;        // one entry per level at most; the builder checks the depth
+constexpr int kWideShortStack = 4;        // groups held in registers (WideShortStack)
 
 // One node. Child i's box is p + 2^(e - 127) * q in each axis, rounded outward when
 // built, so it holds the child's real box. meta[i]: 0 for an empty slot; an inner child
@@ -106,6 +111,39 @@ PB_HD float byte_as_float(uint32_t w, int k) {
   return word_as_float(bits) - 8388608.0f;
 }
 
+// A stack entry: a node's inner children from `base` and which of them are left to visit
+// (bits 24..31, octant order), with the node's imask in bits 0..7.
+struct WideGroup {
+  uint32_t base, hits;
+};
+
+// The traversal stack: the N most recent groups in registers (top[0] the newest; every
+// index a constant once unrolled, so the array is registers, and a push or pop is 2N moves),
+// the older ones in `spill` (local memory), touched only when more than N are held.
+template <int N>
+struct WideShortStack {
+  WideGroup top[N] = {};
+  WideGroup spill[kWideStackSize - N];
+  int size = 0;
+
+  PB_HD bool empty() const { return size == 0; }
+  PB_HD void push(const WideGroup& g) {
+    if (size >= N) spill[size - N] = top[N - 1];
+    PB_WIDE_UNROLL
+    for (int k = N - 1; k > 0; --k) top[k] = top[k - 1];
+    top[0] = g;
+    ++size;
+  }
+  PB_HD WideGroup pop() {  // !empty()
+    const WideGroup g = top[0];
+    PB_WIDE_UNROLL
+    for (int k = 0; k < N - 1; ++k) top[k] = top[k + 1];
+    --size;
+    if (size >= N) top[N - 1] = spill[size - N];
+    return g;
+  }
+};
+
 }  // namespace detail
 
 // Closest hit (kAnyHit = false) or any hit, as traverse() in binary_bvh.h: same triangle test,
@@ -125,14 +163,10 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
   const bool neg[3] = {inv.x < 0.0f, inv.y < 0.0f, inv.z < 0.0f};
   const float inv_a[3] = {inv.x, inv.y, inv.z}, oi_a[3] = {oi.x, oi.y, oi.z};
 
-  struct Group {
-    uint32_t base, hits;  // hits: inner children in bits 24..31 (octant order), imask in 0..7
-  };
-  Group stack[kWideStackSize];
-  int sp = 0;
+  detail::WideShortStack<kWideShortStack> stack;
   // The root as the only child of a virtual node: popping bit 31 gives slot 7 ^ oct_inv,
   // and an empty imask makes its index base + 0.
-  Group ng{0u, 0x80000000u};
+  detail::WideGroup ng{0u, 0x80000000u};
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   for (;;) {
@@ -142,7 +176,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       ng.hits &= ~(1u << bit);
       const uint32_t slot = (bit - 24u) ^ oct_inv;
       const uint32_t index = ng.base + detail::popcount(ng.hits & 0xFFu & ((1u << slot) - 1u));
-      if (ng.hits & 0xFF000000u) stack[sp++] = ng;
+      if (ng.hits & 0xFF000000u) stack.push(ng);
       uint32_t w[20];
       detail::load_wide_node(bvh.nodes, index, w);
       if (stats) ++stats->nodes;
@@ -199,8 +233,8 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       }
     }
     if (!(ng.hits & 0xFF000000u)) {
-      if (sp == 0) break;
-      ng = stack[--sp];
+      if (stack.empty()) break;
+      ng = stack.pop();
     }
   }
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
