@@ -410,6 +410,7 @@ TEST(BvhLayout, LeavesRefusesInstancesAndLargeScenes) {
 // stack: pushes and pops past its register part come back in LIFO order, to the full depth.
 TEST(WideBvh, ShortStackIsAPlainStack) {
   detail::WideShortStack<kWideShortStack> s;
+  detail::WideGroup spill[detail::kWideSpillSize];
   std::vector<detail::WideGroup> model;
   std::mt19937 rng(3);
   size_t deepest = 0;
@@ -417,11 +418,11 @@ TEST(WideBvh, ShortStackIsAPlainStack) {
     const bool push = model.empty() || (model.size() < size_t(kWideStackSize) && rng() % 100 < 55);
     if (push) {
       const detail::WideGroup g{uint32_t(rng()), uint32_t(rng())};
-      s.push(g);
+      s.push(g, spill);
       model.push_back(g);
       deepest = std::max(deepest, model.size());
     } else {
-      const detail::WideGroup g = s.pop();
+      const detail::WideGroup g = s.pop(spill);
       ASSERT_EQ(g.base, model.back().base) << "step " << i;
       ASSERT_EQ(g.hits, model.back().hits) << "step " << i;
       model.pop_back();

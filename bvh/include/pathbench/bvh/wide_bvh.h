@@ -119,22 +119,24 @@ struct WideGroup {
 
 // The traversal stack: the N most recent groups in registers (top[0] the newest; every
 // index a constant once unrolled, so the array is registers, and a push or pop is 2N moves),
-// the older ones in `spill` (local memory), touched only when more than N are held.
+// the older ones in the caller's `spill` array (local memory), touched only when more than
+// N are held. The spill array is not a member: an aggregate holding a dynamically indexed
+// array is kept whole in local memory by the compiler (the PTX of k_trace showed `top` in
+// the local depot), so the two live apart.
 template <int N>
 struct WideShortStack {
   WideGroup top[N] = {};
-  WideGroup spill[kWideStackSize - N];
   int size = 0;
 
   PB_HD bool empty() const { return size == 0; }
-  PB_HD void push(const WideGroup& g) {
+  PB_HD void push(const WideGroup& g, WideGroup* spill) {
     if (size >= N) spill[size - N] = top[N - 1];
     PB_WIDE_UNROLL
     for (int k = N - 1; k > 0; --k) top[k] = top[k - 1];
     top[0] = g;
     ++size;
   }
-  PB_HD WideGroup pop() {  // !empty()
+  PB_HD WideGroup pop(const WideGroup* spill) {  // !empty()
     const WideGroup g = top[0];
     PB_WIDE_UNROLL
     for (int k = 0; k < N - 1; ++k) top[k] = top[k + 1];
@@ -143,6 +145,7 @@ struct WideShortStack {
     return g;
   }
 };
+constexpr int kWideSpillSize = kWideStackSize - kWideShortStack;
 
 }  // namespace detail
 
@@ -164,6 +167,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
   const float inv_a[3] = {inv.x, inv.y, inv.z}, oi_a[3] = {oi.x, oi.y, oi.z};
 
   detail::WideShortStack<kWideShortStack> stack;
+  detail::WideGroup spill[detail::kWideSpillSize];
   // The root as the only child of a virtual node: popping bit 31 gives slot 7 ^ oct_inv,
   // and an empty imask makes its index base + 0.
   detail::WideGroup ng{0u, 0x80000000u};
@@ -176,7 +180,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       ng.hits &= ~(1u << bit);
       const uint32_t slot = (bit - 24u) ^ oct_inv;
       const uint32_t index = ng.base + detail::popcount(ng.hits & 0xFFu & ((1u << slot) - 1u));
-      if (ng.hits & 0xFF000000u) stack.push(ng);
+      if (ng.hits & 0xFF000000u) stack.push(ng, spill);
       uint32_t w[20];
       detail::load_wide_node(bvh.nodes, index, w);
       if (stats) ++stats->nodes;
@@ -234,7 +238,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
     }
     if (!(ng.hits & 0xFF000000u)) {
       if (stack.empty()) break;
-      ng = stack.pop();
+      ng = stack.pop(spill);
     }
   }
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
