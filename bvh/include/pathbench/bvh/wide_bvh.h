@@ -35,7 +35,12 @@ namespace pb::bvh {
 constexpr uint32_t kWideMaxChildren = 8;
 constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
 constexpr int kWideStackSize = 64;        // one entry per level at most; the builder checks the depth
-constexpr int kWideShortStack = 4;        // groups held in registers (WideShortStack)
+// Groups held in registers (WideShortStack); 0: a plain stack in local memory, as before
+// (-DPB_WIDE_SHORT_STACK=N builds another size, for A/B on the device).
+#ifndef PB_WIDE_SHORT_STACK
+#define PB_WIDE_SHORT_STACK 4
+#endif
+constexpr int kWideShortStack = PB_WIDE_SHORT_STACK;
 
 // One node. Child i's box is p + 2^(e - 127) * q in each axis, rounded outward when
 // built, so it holds the child's real box. meta[i]: 0 for an empty slot; an inner child
@@ -144,6 +149,13 @@ struct WideShortStack {
     if (size >= N) top[N - 1] = spill[size - N];
     return g;
   }
+};
+template <>
+struct WideShortStack<0> {  // the plain stack: every group in `spill`
+  int size = 0;
+  PB_HD bool empty() const { return size == 0; }
+  PB_HD void push(const WideGroup& g, WideGroup* spill) { spill[size++] = g; }
+  PB_HD WideGroup pop(const WideGroup* spill) { return spill[--size]; }
 };
 constexpr int kWideSpillSize = kWideStackSize - kWideShortStack;
 
