@@ -52,9 +52,10 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/archive/pixel-occupancy-8).
 constexpr int kPixelLatencyBlocks = 8;
 // The wide BVH's megakernel holds a node's 20 words and the ray's slab constants across its
-// child tests: at 8 blocks (32 registers) it spilled them (ico:8 wide8 took 99.9 ms on an
-// H200 against binary's 48.1). It gets its own counts (registers 80, 64, 48, 40, 32), and
-// its latency-bound build is kWideLatencyBlocks (docs/notes/gpu-log.md, "Wide BVH: own
+// child tests: at 8 blocks (32 registers) it spills them. It gets its own counts (at most
+// 80, 64, 48, 40, 32 registers), and its latency-bound build is kWideLatencyBlocks: on an
+// H100, paper-cornell-ico:8 256x256x800 nee, interleaved, 4 blocks 92.76 ms, 5 blocks
+// 92.15, 8 blocks 103.80 (binary at 8: 43.03; docs/notes/gpu-log.md, "Wide BVH: own
 // occupancy, short stack").
 constexpr int kWidePixelBlocks[] = {3, 4, 5, 6, 8};
 constexpr int kWideLatencyBlocks = 5;

@@ -408,9 +408,10 @@ TEST(BvhLayout, LeavesRefusesInstancesAndLargeScenes) {
 
 // The wide traversal's short stack (registers over a local-memory array) is a plain
 // stack: pushes and pops past its register part come back in LIFO order, to the full depth.
-TEST(WideBvh, ShortStackIsAPlainStack) {
-  detail::WideShortStack<kWideShortStack> s;
-  detail::WideGroup spill[detail::kWideSpillSize];
+template <int N>
+void check_short_stack() {
+  detail::WideShortStack<N> s;
+  detail::WideGroup spill[kWideStackSize - N];
   std::vector<detail::WideGroup> model;
   std::mt19937 rng(3);
   size_t deepest = 0;
@@ -423,13 +424,18 @@ TEST(WideBvh, ShortStackIsAPlainStack) {
       deepest = std::max(deepest, model.size());
     } else {
       const detail::WideGroup g = s.pop(spill);
-      ASSERT_EQ(g.base, model.back().base) << "step " << i;
-      ASSERT_EQ(g.hits, model.back().hits) << "step " << i;
+      ASSERT_EQ(g.base, model.back().base) << "N " << N << ", step " << i;
+      ASSERT_EQ(g.hits, model.back().hits) << "N " << N << ", step " << i;
       model.pop_back();
     }
     ASSERT_EQ(s.empty(), model.empty());
   }
-  EXPECT_GT(deepest, size_t(kWideShortStack) + 8);  // the local-memory part was used
+  EXPECT_GT(deepest, size_t(N) + 8);  // the local-memory part was used
+}
+
+TEST(WideBvh, ShortStackIsAPlainStack) {
+  check_short_stack<0>();  // the default (kWideShortStack)
+  check_short_stack<4>();  // 4 groups in registers over the local array
 }
 
 // The quantised child boxes hold the children they stand for: every triangle of a

@@ -10,11 +10,12 @@
 // Traversal follows the paper: a stack of "node groups" (the base index of a node's inner
 // children + a mask of the ones the ray hit, ordered by the ray's octant so that popping
 // the highest bit takes the child nearest the ray's origin first), the hit leaves'
-// triangles tested as soon as the node is (one bit each in the low 24 bits). The stack is
-// a short one in registers (WideShortStack: the kWideShortStack most recent groups, as
+// triangles tested as soon as the node is (one bit each in the low 24 bits). The stack can
+// be a short one in registers (WideShortStack: the kWideShortStack most recent groups, as
 // Vaidyanathan, Woop & Benthin, HPG 2019, keep theirs), over a backing array in local
 // memory for the older ones: nothing is dropped and no restart is needed, so the visit
-// order, and every hit, is that of a plain stack.
+// order, and every hit, is that of a plain stack. Measured slower on the GPU (below): the
+// default is the plain stack in local memory.
 #include <cstdint>
 #include <cstring>
 
@@ -35,10 +36,14 @@ namespace pb::bvh {
 constexpr uint32_t kWideMaxChildren = 8;
 constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
 constexpr int kWideStackSize = 64;        // one entry per level at most; the builder checks the depth
-// Groups held in registers (WideShortStack); 0: a plain stack in local memory, as before
-// (-DPB_WIDE_SHORT_STACK=N builds another size, for A/B on the device).
+// Groups held in registers (WideShortStack); 0: a plain stack in local memory.
+// -DPB_WIDE_SHORT_STACK=N builds another size. Measured on an H100 (paper-cornell-ico:8,
+// 256x256x800 nee, megakernel; docs/notes/gpu-log.md, "Wide BVH: own occupancy, short
+// stack"): 4 groups in registers took 104.2 ms at 5 blocks an SM, the plain stack 92.2: at
+// the 48 to 64 registers a wide megakernel may hold, 8 more live registers push path state
+// into spills (ptxas: 5 blocks, 932 / 848 bytes spilled with it). So 0 by default.
 #ifndef PB_WIDE_SHORT_STACK
-#define PB_WIDE_SHORT_STACK 4
+#define PB_WIDE_SHORT_STACK 0
 #endif
 constexpr int kWideShortStack = PB_WIDE_SHORT_STACK;
 
