@@ -83,7 +83,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
       for (int n : kWidePixelBlocks) ok = ok || v == std::to_string(n);
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
-                                   "auto, 3, 4, 5, 6 or 8)", v, kPixelLatencyBlocks));
+                                   "auto, 3, 5 or 8)", v, kPixelLatencyBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }
   if (g.bvh_tris >= kPixelLatencyBoundTris)
@@ -119,9 +119,8 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
         };
         using I = std::integral_constant<int, 3>;
         if constexpr (B == int(TraversalKind::Wide)) {  // kWidePixelBlocks
-          if (min_blocks == 4) at(std::integral_constant<int, 4>{});
-          else if (min_blocks == 5) at(std::integral_constant<int, 5>{});
-          else if (min_blocks == 6) at(std::integral_constant<int, 6>{});
+          static_assert(kWideLatencyBlocks == 5 && kPixelLatencyBlocks == 8, "kWidePixelBlocks: 3, 5, 8");
+          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
           else if (min_blocks == 8) at(std::integral_constant<int, 8>{});
           else at(I{});
         } else {

@@ -52,12 +52,13 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/archive/pixel-occupancy-8).
 constexpr int kPixelLatencyBlocks = 8;
 // The wide BVH's megakernel holds a node's 20 words and the ray's slab constants across its
-// child tests: at 8 blocks (32 registers) it spills them. It gets its own counts (at most
-// 80, 64, 48, 40, 32 registers), and its latency-bound build is kWideLatencyBlocks: on an
-// H100, paper-cornell-ico:8 256x256x800 nee, interleaved, 4 blocks 92.76 ms, 5 blocks
-// 92.15, 8 blocks 103.80 (binary at 8: 43.03; docs/notes/gpu-log.md, "Wide BVH: own
-// occupancy, short stack").
-constexpr int kWidePixelBlocks[] = {3, 4, 5, 6, 8};
+// child tests: at 8 blocks (32 registers) it spills them. It gets a count of its own for
+// latency-bound scenes, kWideLatencyBlocks (at most 48 registers): on an H100,
+// paper-cornell-ico:8 256x256x800 nee, interleaved, 4 blocks 92.76 ms, 5 blocks 92.15, 8
+// blocks 103.80 (binary at 8: 43.03; docs/notes/gpu-log.md, "Wide BVH: own occupancy, short
+// stack"). Measured with 4 and 6 compiled too; kept to 3, 5 and 8 (each count is one more
+// megakernel per material set and variance flag in pixel.cu's compile).
+constexpr int kWidePixelBlocks[] = {3, 5, 8};
 constexpr int kWideLatencyBlocks = 5;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
