@@ -89,7 +89,14 @@ void register_paper_cornell(uint32_t side, uint32_t spp, uint32_t raycast_side) 
 
 void preset_quick() { register_paper_cornell(64, 4, 128); }
 
-void preset_paper() { register_paper_cornell(256, 800, 256); }
+void preset_paper() {
+  register_paper_cornell(256, 800, 256);
+#if PATHBENCH_BENCH_GPU
+  // Issue 32's large-scene row: paper-cornell-ico:8 (1.31 M triangles), GPU megakernel, the
+  // paper's frame with light sampling (the layout `auto` picks; bvh_layout.h).
+  register_render_benchmark(render_case("paper-cornell-ico:8", Device::Gpu, Strategy::Pixel, 256, 256, 800, 2, Sampling::Nee));
+#endif
+}
 
 // Largest scaling scene; 10^7 needs several GB and about a minute per build on 2 cores.
 uint64_t scaling_max_triangles() {

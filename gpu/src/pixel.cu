@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <string>
+#include <type_traits>
 
 #include "device_film.cuh"
 #include "gpu_scene_impl.cuh"
@@ -72,16 +73,22 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
 }  // namespace
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
+  const bool wide = g.bvh.kind == TraversalKind::Wide;
+  const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   const std::string v = env ? env : "auto";
-  if (v == "3") return {3, "PATHBENCH_GPU_PIXEL_BLOCKS=3"};
-  if (v == std::to_string(kPixelLatencyBlocks))
-    return {kPixelLatencyBlocks, "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
-  if (v != "auto")
-    throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {}", v, kPixelLatencyBlocks));
+  if (v != "auto") {
+    bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks);
+    if (wide)
+      for (int n : kWidePixelBlocks) ok = ok || v == std::to_string(n);
+    if (!ok)
+      throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
+                                   "auto, 3, 5 or 8)", v, kPixelLatencyBlocks));
+    return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
+  }
   if (g.bvh_tris >= kPixelLatencyBoundTris)
-    return {kPixelLatencyBlocks,
-            fmt::format("auto: {} triangles >= {} (latency bound: more warps)", g.bvh_tris, kPixelLatencyBoundTris)};
+    return {latency, fmt::format("auto: {} triangles >= {} (latency bound: more warps{})", g.bvh_tris,
+                                 kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
 
@@ -106,9 +113,20 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
     else
       with_traversal_kind(g.bvh, [&](auto kind) {
         constexpr int B = decltype(kind)::value;
-        constexpr int L = kPixelLatencyBlocks;
-        if (min_blocks == L) variance ? go(k_pixel<true, K, float, true, B, L>) : go(k_pixel<false, K, float, true, B, L>);
-        else variance ? go(k_pixel<true, K, float, true, B, 3>) : go(k_pixel<false, K, float, true, B, 3>);
+        auto at = [&](auto blocks) {
+          constexpr int N = decltype(blocks)::value;
+          variance ? go(k_pixel<true, K, float, true, B, N>) : go(k_pixel<false, K, float, true, B, N>);
+        };
+        using I = std::integral_constant<int, 3>;
+        if constexpr (B == int(TraversalKind::Wide)) {  // kWidePixelBlocks
+          static_assert(kWideLatencyBlocks == 5 && kPixelLatencyBlocks == 8, "kWidePixelBlocks: 3, 5, 8");
+          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
+          else if (min_blocks == 8) at(std::integral_constant<int, 8>{});
+          else at(I{});
+        } else {
+          if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
+          else at(I{});
+        }
       });
   });
   FrameResult r;

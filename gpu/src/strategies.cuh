@@ -39,7 +39,8 @@ struct ShadowUse {
 // The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
 // and the megakernel waits on memory (more warps hide it); below, it is issue bound.
-// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 overrides it (a bad value: InputError).
+// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 overrides it (a bad value: InputError); the wide
+// BVH's megakernel is compiled for more counts (kWidePixelBlocks) and takes any of them.
 struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
@@ -50,6 +51,15 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // (48 registers): ico:5 35.81 -> 35.69 ms, ico:7 43.12 -> 42.92, ico:8 49.08 -> 47.96
 // (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/archive/pixel-occupancy-8).
 constexpr int kPixelLatencyBlocks = 8;
+// The wide BVH's megakernel holds a node's 20 words and the ray's slab constants across its
+// child tests: at 8 blocks (32 registers) it spills them. It gets a count of its own for
+// latency-bound scenes, kWideLatencyBlocks (at most 48 registers): on an H100,
+// paper-cornell-ico:8 256x256x800 nee, interleaved, 4 blocks 92.76 ms, 5 blocks 92.15, 8
+// blocks 103.80 (binary at 8: 43.03; docs/notes/gpu-log.md, "Wide BVH: own occupancy, short
+// stack"). Measured with 4 and 6 compiled too; kept to 3, 5 and 8 (each count is one more
+// megakernel per material set and variance flag in pixel.cu's compile).
+constexpr int kWidePixelBlocks[] = {3, 5, 8};
+constexpr int kWideLatencyBlocks = 5;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from

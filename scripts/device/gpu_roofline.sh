@@ -8,6 +8,7 @@
 # --clock-control none: the clocks stay as the benchmarks see them (METHOD.md); each
 # kernel launch is replayed by ncu, so the frames are small (the rates per kernel are
 # what counts, not the frame time) and at most LAUNCHES launches are profiled per run.
+# ROOFLINE_ONLY=REGEX runs only the runs whose name matches.
 set -uo pipefail
 build=${1:?usage: scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR}
 out=${2:?usage: scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR}
@@ -21,6 +22,7 @@ l1tex__t_sectors.avg.pct_of_peak_sustained_elapsed,sm__warps_active.avg.pct_of_p
 smsp__thread_inst_executed_per_inst_executed.ratio,launch__registers_per_thread
 run() {  # name, then pathbench render arguments
   local name=$1; shift
+  [[ -n ${ROOFLINE_ONLY:-} && ! $name =~ ${ROOFLINE_ONLY} ]] && return  # ROOFLINE_ONLY=REGEX: those runs alone
   echo "== $name"
   timeout 300 ncu --clock-control none --csv --print-units base --metrics "$metrics" --launch-count "$launches" \
     "$build/bin/pathbench" render --device gpu --quiet "$@" > "$out/$name.csv" 2> "$out/$name.err"
@@ -31,4 +33,6 @@ run paper-cornell-pixel --scene paper-cornell --strategy pixel --spp 64 "${commo
 run paper-cornell-wavefront --scene paper-cornell --strategy wavefront --spp 16 "${common[@]}"
 run paper-cornell-paper-queue --scene paper-cornell --strategy paper-queue --spp 16 "${common[@]}"
 run ico8-pixel --scene paper-cornell-ico:8 --strategy pixel --spp 16 "${common[@]}"
+# Issue 32: the same megakernel on the wide BVH (ico8-pixel: the layout auto picks, binary).
+PATHBENCH_GPU_BVH=wide8 run ico8-wide8-pixel --scene paper-cornell-ico:8 --strategy pixel --spp 16 "${common[@]}"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem,power.limit --format=csv > "$out/nvidia-smi.csv"

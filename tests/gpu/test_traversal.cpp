@@ -4,12 +4,14 @@
 // leaves: bvh_layout.h); the other layouts also against the binary BVH, hit for hit. Runs without a GPU (CTest label `unit`).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ostream>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "pathbench/bvh/bvh_build.h"
 #include "pathbench/bvh/bvh_layout.h"
@@ -402,6 +404,38 @@ TEST(BvhLayout, LeavesRefusesInstancesAndLargeScenes) {
   }
   o.layout = GpuBvhLayout::Auto;  // auto never picks it there
   EXPECT_EQ(build_scene_bvh(inst, o).layout, GpuBvhLayout::Binary);
+}
+
+// The wide traversal's short stack (registers over a local-memory array) is a plain
+// stack: pushes and pops past its register part come back in LIFO order, to the full depth.
+template <int N>
+void check_short_stack() {
+  detail::WideShortStack<N> s;
+  detail::WideGroup spill[kWideStackSize - N];
+  std::vector<detail::WideGroup> model;
+  std::mt19937 rng(3);
+  size_t deepest = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const bool push = model.empty() || (model.size() < size_t(kWideStackSize) && rng() % 100 < 55);
+    if (push) {
+      const detail::WideGroup g{uint32_t(rng()), uint32_t(rng())};
+      s.push(g, spill);
+      model.push_back(g);
+      deepest = std::max(deepest, model.size());
+    } else {
+      const detail::WideGroup g = s.pop(spill);
+      ASSERT_EQ(g.base, model.back().base) << "N " << N << ", step " << i;
+      ASSERT_EQ(g.hits, model.back().hits) << "N " << N << ", step " << i;
+      model.pop_back();
+    }
+    ASSERT_EQ(s.empty(), model.empty());
+  }
+  EXPECT_GT(deepest, size_t(N) + 8);  // the local-memory part was used
+}
+
+TEST(WideBvh, ShortStackIsAPlainStack) {
+  check_short_stack<0>();  // the default (kWideShortStack)
+  check_short_stack<4>();  // 4 groups in registers over the local array
 }
 
 // The quantised child boxes hold the children they stand for: every triangle of a

@@ -34,6 +34,13 @@ enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3,
 // 256x256x800 pixel 13.7 ms (wide8 19.7, wide4 38.2, brute 18.4), wavefront 19.2 ms
 // (wide8 21.5, brute 25.5); ico:8 pixel 75.8 ms (wide8 114.2, wide4 147.3); brute force
 // never beat it, so auto means binary and brute force is off unless asked for.
+// Measured again for issue 32 with the wide megakernel at its own occupancy (5 blocks; the
+// plain stack: a short stack in registers was slower), H100, 256x256x800 nee, interleaved
+// (results/nvidia-h100-80gb-hbm3/archive/wide-bvh-eed5258): wide8 loses everywhere, from
+// 1.3 k to 13.3 M triangles: ico:8 43.03 ms binary against 92.15 wide8, the suite's
+// bunny-armadillo 44.92 / 111.86, glass-dragon 200.66 / 471.56, large-mesh 55.08 / 131.26.
+// The rule stays: leaves up to kLeavesAutoMaxTriangles (no instances), two-level where
+// --instancing says so, else binary; wide4 / wide8 only by name.
 constexpr GpuBvhLayout kAutoLayout = GpuBvhLayout::Binary;
 constexpr uint32_t kDefaultBruteMaxTriangles = 0;
 constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute force is never the answer

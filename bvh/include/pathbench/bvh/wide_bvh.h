@@ -10,7 +10,12 @@
 // Traversal follows the paper: a stack of "node groups" (the base index of a node's inner
 // children + a mask of the ones the ray hit, ordered by the ray's octant so that popping
 // the highest bit takes the child nearest the ray's origin first), the hit leaves'
-// triangles tested as soon as the node is (one bit each in the low 24 bits).
+// triangles tested as soon as the node is (one bit each in the low 24 bits). The stack can
+// be a short one in registers (WideShortStack: the kWideShortStack most recent groups, as
+// Vaidyanathan, Woop & Benthin, HPG 2019, keep theirs), over a backing array in local
+// memory for the older ones: nothing is dropped and no restart is needed, so the visit
+// order, and every hit, is that of a plain stack. Measured slower on the GPU (below): the
+// default is the plain stack in local memory.
 #include <cstdint>
 #include <cstring>
 
@@ -31,6 +36,16 @@ namespace pb::bvh {
 constexpr uint32_t kWideMaxChildren = 8;
 constexpr uint32_t kWideMaxLeafTris = 3;  // unary count in the top 3 bits of meta
 constexpr int kWideStackSize = 64;        // one entry per level at most; the builder checks the depth
+// Groups held in registers (WideShortStack); 0: a plain stack in local memory.
+// -DPB_WIDE_SHORT_STACK=N builds another size. Measured on an H100 (paper-cornell-ico:8,
+// 256x256x800 nee, megakernel; docs/notes/gpu-log.md, "Wide BVH: own occupancy, short
+// stack"): 4 groups in registers took 104.2 ms at 5 blocks an SM, the plain stack 92.2: at
+// the 48 to 64 registers a wide megakernel may hold, 8 more live registers push path state
+// into spills (ptxas: 5 blocks, 932 / 848 bytes spilled with it). So 0 by default.
+#ifndef PB_WIDE_SHORT_STACK
+#define PB_WIDE_SHORT_STACK 0
+#endif
+constexpr int kWideShortStack = PB_WIDE_SHORT_STACK;
 
 // One node. Child i's box is p + 2^(e - 127) * q in each axis, rounded outward when
 // built, so it holds the child's real box. meta[i]: 0 for an empty slot; an inner child
@@ -106,6 +121,49 @@ PB_HD float byte_as_float(uint32_t w, int k) {
   return word_as_float(bits) - 8388608.0f;
 }
 
+// A stack entry: a node's inner children from `base` and which of them are left to visit
+// (bits 24..31, octant order), with the node's imask in bits 0..7.
+struct WideGroup {
+  uint32_t base, hits;
+};
+
+// The traversal stack: the N most recent groups in registers (top[0] the newest; every
+// index a constant once unrolled, so the array is registers, and a push or pop is 2N moves),
+// the older ones in the caller's `spill` array (local memory), touched only when more than
+// N are held. The spill array is not a member: an aggregate holding a dynamically indexed
+// array is kept whole in local memory by the compiler (the PTX of k_trace showed `top` in
+// the local depot), so the two live apart.
+template <int N>
+struct WideShortStack {
+  WideGroup top[N] = {};
+  int size = 0;
+
+  PB_HD bool empty() const { return size == 0; }
+  PB_HD void push(const WideGroup& g, WideGroup* spill) {
+    if (size >= N) spill[size - N] = top[N - 1];
+    PB_WIDE_UNROLL
+    for (int k = N - 1; k > 0; --k) top[k] = top[k - 1];
+    top[0] = g;
+    ++size;
+  }
+  PB_HD WideGroup pop(const WideGroup* spill) {  // !empty()
+    const WideGroup g = top[0];
+    PB_WIDE_UNROLL
+    for (int k = 0; k < N - 1; ++k) top[k] = top[k + 1];
+    --size;
+    if (size >= N) top[N - 1] = spill[size - N];
+    return g;
+  }
+};
+template <>
+struct WideShortStack<0> {  // the plain stack: every group in `spill`
+  int size = 0;
+  PB_HD bool empty() const { return size == 0; }
+  PB_HD void push(const WideGroup& g, WideGroup* spill) { spill[size++] = g; }
+  PB_HD WideGroup pop(const WideGroup* spill) { return spill[--size]; }
+};
+constexpr int kWideSpillSize = kWideStackSize - kWideShortStack;
+
 }  // namespace detail
 
 // Closest hit (kAnyHit = false) or any hit, as traverse() in binary_bvh.h: same triangle test,
@@ -125,14 +183,11 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
   const bool neg[3] = {inv.x < 0.0f, inv.y < 0.0f, inv.z < 0.0f};
   const float inv_a[3] = {inv.x, inv.y, inv.z}, oi_a[3] = {oi.x, oi.y, oi.z};
 
-  struct Group {
-    uint32_t base, hits;  // hits: inner children in bits 24..31 (octant order), imask in 0..7
-  };
-  Group stack[kWideStackSize];
-  int sp = 0;
+  detail::WideShortStack<kWideShortStack> stack;
+  detail::WideGroup spill[detail::kWideSpillSize];
   // The root as the only child of a virtual node: popping bit 31 gives slot 7 ^ oct_inv,
   // and an empty imask makes its index base + 0.
-  Group ng{0u, 0x80000000u};
+  detail::WideGroup ng{0u, 0x80000000u};
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
   for (;;) {
@@ -142,7 +197,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       ng.hits &= ~(1u << bit);
       const uint32_t slot = (bit - 24u) ^ oct_inv;
       const uint32_t index = ng.base + detail::popcount(ng.hits & 0xFFu & ((1u << slot) - 1u));
-      if (ng.hits & 0xFF000000u) stack[sp++] = ng;
+      if (ng.hits & 0xFF000000u) stack.push(ng, spill);
       uint32_t w[20];
       detail::load_wide_node(bvh.nodes, index, w);
       if (stats) ++stats->nodes;
@@ -199,8 +254,8 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
       }
     }
     if (!(ng.hits & 0xFF000000u)) {
-      if (sp == 0) break;
-      ng = stack[--sp];
+      if (stack.empty()) break;
+      ng = stack.pop(spill);
     }
   }
   return detail::finish_closest<kWatertight>(bvh.tris, o, d, t_max, hit, hit_slot, t, t_hit);
