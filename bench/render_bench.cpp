@@ -189,7 +189,6 @@ void register_render_benchmark(const RenderCase& c) {
                                          [copy](benchmark::State& st) { run_render(st, copy); });
   b->UseManualTime()->Unit(benchmark::kMillisecond);
   if (copy.iterations > 0) b->Iterations(copy.iterations);
-  if (copy.repetitions > 0) b->Repetitions(copy.repetitions);
 }
 
 }  // namespace pb::bench

@@ -39,7 +39,6 @@ struct RenderCase {
   // frame on it, so the energy window holds frames only; the build's seconds are the counter
   // build_seconds. Other presets keep one full render (build included, untimed) per iteration.
   bool build_once = false;
-  int repetitions = 0;  // this benchmark's repetitions; 0 = --benchmark_repetitions
 };
 
 std::string render_benchmark_name(const RenderCase& c);

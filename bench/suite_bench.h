@@ -4,12 +4,11 @@
 //   pathbench-bench --preset suite --suite-cases FILE [--benchmark_* options]
 // FILE: {"suite": "pathbench", "version": 1, "mode": "quick"|"full", "manifest_sha256": "...",
 //        "device_label": "cpu"|"gpu"|..., "cases": [{"name": "suite/<workload>/<device>/<strategy>",
-//        "scene": built-in name or path, "device": "cpu"|"gpu", "iterations": 0, "repetitions": 0,
+//        "scene": built-in name or path, "device": "cpu"|"gpu", "iterations": 0,
 //        "settings": {width, height, spp, bounces, sampling, strategy, isa, instancing,
 //                     precision, embree_layout, seed, converged}}]}
 // Each case is a render benchmark (render_bench.h: time, rays/s, memory, energy, clocks) whose
 // scene is built once on its device (RenderCase::build_once: the counter build_seconds).
-// "repetitions" (optional, >= 1) overrides --benchmark_repetitions for that case.
 #include <string>
 
 namespace pb::bench {
