@@ -76,8 +76,8 @@ say "lanes done"
 tail -n 14 "$out/suite-gpu.txt" "$out/suite-cpu.txt" "$out/crosscheck-gpu.txt" 2>/dev/null
 # A run cut short leaves its finished bench JSON in the suite's hidden work folder: keep it.
 for d in "$out"/.suite-*.partial-*; do [ -d "$d" ] && mv "$d" "$out/partial-$(basename "$d" | tr -c 'a-zA-Z0-9_\n-' _)"; done
-# At most 8 files come back: the log and one tarball of the rest.
-(cd "$out" && cp device-log.txt device-log.keep && tar czf results.tar.gz --exclude=device-log.keep --exclude=results.tar.gz \
-  . && find . -mindepth 1 -maxdepth 1 ! -name results.tar.gz ! -name device-log.keep -exec rm -rf {} + &&
-  mv device-log.keep device-log.txt)
+# At most 8 files, each under 16 MiB, come back: the log and one tarball of the rest, without the
+# crosscheck's exported meshes and images (24 MB at 2cae000: the tarball did not come back).
+(cd "$out" && tar czf /tmp/results.tar.gz --exclude='*.ply' --exclude='*.pfm' --exclude='*.obj' . &&
+  find . -mindepth 1 -maxdepth 1 ! -name device-log.txt -exec rm -rf {} + && mv /tmp/results.tar.gz .)
 ls -la "$out"
