@@ -315,9 +315,9 @@ def test_frames_on_a_scene_built_once_give_the_renders_image_and_fewer_repetitio
     assert "paper-uniform 2" in dict(s["facts"])["repetitions"]
     for name, sampling in (("paper-nee", "nee"), ("paper-uniform", "uniform")):
         rep = tmp_path / f"{name}.json"
-        rr = subprocess.run([str(PATHBENCH), "render", "--scene", "paper-cornell", "--device", "cpu", "--width", "32", "--height",
-                             "32", "--spp", "4", "--bounces", "2", "--sampling", sampling, "--report", str(rep)],
-                            capture_output=True, text=True, timeout=300)
+        args = ["--scene", "paper-cornell", "--device", "cpu", "--width", "32", "--height", "32", "--spp", "4",
+                "--bounces", "2", "--sampling", sampling, "--report", str(rep)]
+        rr = subprocess.run([str(PATHBENCH), "render", *args], capture_output=True, text=True, timeout=300)
         assert rr.returncode == 0, rr.stderr
         assert by[name]["film_hash"] == strict_load(rep)["film_hash"]
 
@@ -354,8 +354,8 @@ def test_crosscheck_mode_judges_each_workload_and_device_against_mitsuba(tmp_pat
     crosscheck.json (strict) and crosscheck.md; exit 0 when every one passes. On the GPU host:
     --devices gpu --mitsuba-variant cuda_ad_rgb (results/suite/README.md)."""
     out = tmp_path / "cc"
-    r = suite("--manifest", TEST_MANIFEST, "--crosscheck", "--devices", "cpu", "--workloads", "^(paper-nee|cornell-ggx)$",
-              "--crosscheck-size", "24x24", "--crosscheck-spp", "64", "--out", out)
+    r = suite("--manifest", TEST_MANIFEST, "--crosscheck", "--devices", "cpu", "--workloads",
+              "^(paper-nee|cornell-ggx)$", "--crosscheck-size", "24x24", "--crosscheck-spp", "64", "--out", out)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     doc = strict_load(out / "crosscheck.json")
     assert doc["mitsuba_variant"] == "scalar_rgb" and doc["frame"] == [24, 24] and doc["spp"] == 64
