@@ -21,6 +21,7 @@
 //                            the JSON's context.energy_unavailable); GPU also
 //     sm_clock_mhz_mean, sm_clock_mhz_min, temperature_c_max, throttle_reasons (NVML's
 //     clock-event mask, OR over the samples), throttled (1: clocks lowered by power/thermal)
+//   build_seconds       build_once only: wall seconds of the one build (outside the frames)
 #include <string>
 
 #include "pathbench/common/settings.h"
@@ -33,6 +34,11 @@ struct RenderCase {
   int iterations = 0;       // fixed iteration count; 0 = Google Benchmark decides. Each
                             // iteration rebuilds the BVH (untimed), so big scenes want few.
   std::string name;         // the benchmark's name; "" = render/<device>/... as below (the suite names its own)
+  // The suite's cases (issue 28): the device's structure (Embree scene, GPU BVH) is built once
+  // per benchmark (run::PreparedScene, kept for its repetitions) and every iteration renders a
+  // frame on it, so the energy window holds frames only; the build's seconds are the counter
+  // build_seconds. Other presets keep one full render (build included, untimed) per iteration.
+  bool build_once = false;
 };
 
 std::string render_benchmark_name(const RenderCase& c);

@@ -7,7 +7,8 @@
 //        "scene": built-in name or path, "device": "cpu"|"gpu", "iterations": 0,
 //        "settings": {width, height, spp, bounces, sampling, strategy, isa, instancing,
 //                     precision, embree_layout, seed, converged}}]}
-// Each case is a render benchmark (render_bench.h: time, rays/s, memory, energy, clocks).
+// Each case is a render benchmark (render_bench.h: time, rays/s, memory, energy, clocks) whose
+// scene is built once on its device (RenderCase::build_once: the counter build_seconds).
 #include <string>
 
 namespace pb::bench {

@@ -1,6 +1,8 @@
 #pragma once
 // The film of a render, made ready in one place for one process (run.cpp) and for every
 // MPI rank (ranks_render.cpp).
+#include <functional>
+
 #include "pathbench/common/film.h"
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
@@ -13,5 +15,13 @@ namespace pb::run {
 // and begins it for the whole frame's spp: the fixed-point scale every strategy, device
 // and rank shares.
 void prepare_film(const Scene& scene, const RenderSettings& s, const RunOptions& options, Film& film);
+
+// render()'s checks before any build: the settings, the device present, what its tracer runs.
+void check_for_tracer(const RenderSettings& s);
+// Everything render() does around the tracer call `trace` (which fills the tracer's fields
+// of `report`): checks, film, report fields, load, energy, fingerprint, film hash. render()
+// and PreparedScene::render (prepared.h) differ only in `trace`.
+void render_with(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options,
+                 const std::function<void()>& trace);
 
 }  // namespace pb::run

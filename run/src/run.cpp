@@ -40,13 +40,30 @@ void check_discarded(const Scene& scene, const RenderSettings& s, const RunRepor
                                  limits::kMaxEmission));
 }
 
-void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options) {
+void check_for_tracer(const RenderSettings& s) {
   s.validate();
   if (s.device == Device::Gpu) {
     std::string why;
     if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
   }
   validate_for_tracer(s, s.device);  // what the device's tracer runs, before it builds anything
+}
+
+void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options) {
+  render_with(scene, s, film, report, options, [&] {
+    if (s.device == Device::Cpu) {
+      cpu::render(scene, s, film, report);
+    } else {
+#if PATHBENCH_HAVE_CUDA
+      gpu::render(scene, s, film, report, options.profile);
+#endif
+    }
+  });
+}
+
+void render_with(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options,
+                 const std::function<void()>& trace) {
+  check_for_tracer(s);
   prepare_film(scene, s, options, film);
   report.scene = scene.name;
   report.triangles = scene.triangles.size();
@@ -54,13 +71,7 @@ void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& 
   const nlohmann::json start = load_sample();
   std::optional<EnergyMeter> meter;  // around the tracer call: its build and its frame
   if (options.energy) meter.emplace(s.device);
-  if (s.device == Device::Cpu) {
-    cpu::render(scene, s, film, report);
-  } else {
-#if PATHBENCH_HAVE_CUDA
-    gpu::render(scene, s, film, report, options.profile);
-#endif
-  }
+  trace();
   // The load around the tracer alone (so that a contended run can be told from a slow
   // one) and the machine it ran on, filled here once for every caller.
   report.load = load_between(start, load_sample());

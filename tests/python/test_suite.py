@@ -291,3 +291,80 @@ def test_asking_for_a_gpu_where_there_is_none_is_bad_input(tmp_path):
     r = suite("--manifest", TEST_MANIFEST, "--devices", "gpu", "--out", tmp_path / "out", "--no-record")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--devices gpu" in r.stderr
     assert not (tmp_path / "out").exists()
+
+
+@needs_build
+def test_frames_on_a_scene_built_once_give_the_renders_image_and_fewer_repetitions_keep_names(tmp_path):
+    """The suite's benchmarks build the scene once (run::PreparedScene) and time frames on it:
+    the film hash is `pathbench render`'s for the same settings (which builds per call), every
+    row carries build_seconds, and --repetitions-for runs those workloads in a pathbench-bench
+    of their own, so their names stay the history's series (no /repeats:N)."""
+    r = suite("--quick", "--manifest", TEST_MANIFEST, "--devices", "cpu", "--workloads", "^paper-(nee|uniform)$",
+              "--repetitions-for", "uniform=2", "--no-record", "--out", tmp_path / "out")
+    assert r.returncode == 0, r.stderr[-3000:]
+    s = strict_load(tmp_path / "out" / "suite.json")
+    by = {row["workload"]: row for row in s["rows"]}
+    assert by["paper-nee"]["repetitions"] == 9 and by["paper-uniform"]["repetitions"] == 2
+    assert len(s["bench_json"]) == 2  # one pathbench-bench per repetition count
+    names = {b["name"] for f in s["bench_json"] for b in strict_load(tmp_path / "out" / f)["benchmarks"]}
+    assert "suite/paper-uniform/cpu/pixel/manual_time" in names and not any("repeats" in n for n in names)
+    for f in s["bench_json"]:
+        rows = [b for b in strict_load(tmp_path / "out" / f)["benchmarks"] if b["run_type"] == "iteration"]
+        assert rows and all(b["build_seconds"] > 0 for b in rows)
+    assert "(n=2)" in (tmp_path / "out" / "suite.md").read_text()
+    assert "paper-uniform 2" in dict(s["facts"])["repetitions"]
+    for name, sampling in (("paper-nee", "nee"), ("paper-uniform", "uniform")):
+        rep = tmp_path / f"{name}.json"
+        args = ["--scene", "paper-cornell", "--device", "cpu", "--width", "32", "--height", "32", "--spp", "4",
+                "--bounces", "2", "--sampling", sampling, "--report", str(rep)]
+        rr = subprocess.run([str(PATHBENCH), "render", *args], capture_output=True, text=True, timeout=300)
+        assert rr.returncode == 0, rr.stderr
+        assert by[name]["film_hash"] == strict_load(rep)["film_hash"]
+
+
+def mitsuba_available() -> bool:
+    r = subprocess.run([str(ROOT / ".venv" / "bin" / "python"), "-c", "import mitsuba"], capture_output=True)
+    return r.returncode == 0
+
+
+@needs_build
+def test_crosscheck_options_are_checked_before_anything_runs(tmp_path):
+    out = tmp_path / "out"
+    for args, what in [(["--crosscheck-size", "0x5"], "--crosscheck-size '0x5': expected WIDTHxHEIGHT"),
+                       (["--crosscheck-size", "32"], "--crosscheck-size '32'"),
+                       (["--mitsuba-variant", "../x"], "--mitsuba-variant '../x': not a Mitsuba variant"),
+                       (["--crosscheck-spp", "0"], "--crosscheck-spp 0: must be 1 to"),
+                       (["--crosscheck", "--from-json", tmp_path / "x.json"], "--crosscheck: measures nothing itself"),
+                       (["--repetitions-for", "paper=0"], "--repetitions-for 'paper=0': expected REGEX=N"),
+                       (["--repetitions-for", "(=3"], "not a regular expression")]:
+        r = suite("--manifest", TEST_MANIFEST, *args, "--out", out, "--no-record")
+        assert r.returncode == 2, (args, r.stderr)
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and what in lines[0], (args, r.stderr)
+    assert not out.exists()
+    if "cuda: on" not in subprocess.run([str(PATHBENCH), "--version"], capture_output=True, text=True).stdout:
+        r = suite("--manifest", TEST_MANIFEST, "--crosscheck", "--devices", "gpu", "--out", out)
+        assert r.returncode == 2 and "--devices gpu" in r.stderr and not out.exists()
+
+
+@needs_build
+@pytest.mark.skipif(not mitsuba_available(), reason="Mitsuba 3 not installed in .venv")
+def test_crosscheck_mode_judges_each_workload_and_device_against_mitsuba(tmp_path):
+    """--crosscheck: one verdict per (workload, device) with crosscheck's statistic, in
+    crosscheck.json (strict) and crosscheck.md; exit 0 when every one passes. On the GPU host:
+    --devices gpu --mitsuba-variant cuda_ad_rgb (results/suite/README.md)."""
+    out = tmp_path / "cc"
+    r = suite("--manifest", TEST_MANIFEST, "--crosscheck", "--devices", "cpu", "--workloads",
+              "^(paper-nee|cornell-ggx)$", "--crosscheck-size", "24x24", "--crosscheck-spp", "64", "--out", out)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    doc = strict_load(out / "crosscheck.json")
+    assert doc["mitsuba_variant"] == "scalar_rgb" and doc["frame"] == [24, 24] and doc["spp"] == 64
+    rows = {row["workload"]: row for row in doc["rows"]}
+    assert set(rows) == {"paper-nee", "cornell-ggx"}
+    for row in rows.values():
+        assert row["device"] == "cpu" and row["status"] == "pass" and row["values"] == 24 * 24 * 3
+        assert row["share_passed"] >= 0.99 and all(abs(x - 1) <= 0.02 for x in row["mean_ratio"])
+        assert row["mitsuba_spp"] == 256 and row["pathbench_spp"] == 64
+    md = (out / "crosscheck.md").read_text()
+    assert "| paper-nee | cpu | paper-cornell | pass |" in md and "scalar_rgb" in md
+    assert "crosscheck: 2 of 2 pass" in r.stdout

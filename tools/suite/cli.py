@@ -11,13 +11,14 @@ import datetime as dt
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
 
-from . import devices, manifest, page, results, runner
+from . import crosscheck, devices, manifest, page, results, runner
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 REPETITIONS = 9  # `pathbench compare` refuses fewer (its U test)
@@ -49,6 +50,17 @@ def parse_args(argv):
                     "(default auto: the widest the CPU has)")
     ap.add_argument("--repetitions", type=int, default=REPETITIONS, help="per workload and device (default 9, the "
                     "fewest compare's U test takes)")
+    ap.add_argument("--repetitions-for", action="append", default=[], metavar="REGEX=N",
+                    help="N repetitions for the workloads whose name matches REGEX (repeatable; the first match "
+                    "wins): fewer for slow full frames on a CPU; the page shows each row's count")
+    ap.add_argument("--crosscheck", action="store_true", help="no measurement: each workload against Mitsuba 3 on "
+                    "each device (pathbench crosscheck: per-pixel z-test), written as crosscheck.json and .md")
+    ap.add_argument("--mitsuba-variant", default="scalar_rgb", help="--crosscheck: Mitsuba's variant (scalar_rgb; "
+                    "cuda_ad_rgb or llvm_ad_rgb where installed)")
+    ap.add_argument("--crosscheck-size", default="32x32", metavar="WxH", help="--crosscheck: the frame (default "
+                    "32x32; a Mitsuba XML scene renders at its film's size)")
+    ap.add_argument("--crosscheck-spp", type=int, default=64, help="--crosscheck: pathbench's samples per pixel "
+                    "(Mitsuba renders 4x)")
     ap.add_argument("--min-time", type=float, help="seconds of frames per repetition (default: 1 on GPUs, for "
                     "NVML's energy windows; 0.1 quick / 0.5 full on CPUs)")
     ap.add_argument("--manifest", default=os.path.join(ROOT, "scenes", "suite", "manifest.json"))
@@ -69,7 +81,36 @@ def parse_args(argv):
         raise InputError("--repetitions: must be at least 1 (9 for compare's U test)")
     if a.min_time is not None and not (0 < a.min_time <= 3600):
         raise InputError("--min-time: must be in (0, 3600] seconds")
+    a.repetitions_by = _repetitions_for(a.repetitions_for)
+    try:
+        a.crosscheck_frame = crosscheck.parse_size(a.crosscheck_size)
+        crosscheck.check_variant(a.mitsuba_variant)
+    except ValueError as e:
+        raise InputError(str(e)) from None
+    if not 1 <= a.crosscheck_spp <= 1 << 20:
+        raise InputError(f"--crosscheck-spp {a.crosscheck_spp}: must be 1 to {1 << 20}")
+    if a.crosscheck and (a.from_json or a.list):
+        raise InputError("--crosscheck: measures nothing itself; not with --from-json or --list")
     return a
+
+
+def _repetitions_for(specs: list[str]) -> list[tuple]:
+    """--repetitions-for REGEX=N -> [(compiled REGEX, N)]; InputError naming the bad one."""
+    out = []
+    for spec in specs:
+        rx, sep, n = spec.rpartition("=")
+        if not sep or not rx or not n.isdigit() or not 1 <= int(n) <= 1000:
+            raise InputError(f"--repetitions-for {spec!r}: expected REGEX=N with N from 1 to 1000")
+        try:
+            out.append((re.compile(rx), int(n)))
+        except re.error as e:
+            raise InputError(f"--repetitions-for {spec!r}: not a regular expression: {e}") from None
+    return out
+
+
+def repetitions_of(a, workload: str) -> int:
+    """The workload's repetitions: the first --repetitions-for that matches, else --repetitions."""
+    return next((n for rx, n in a.repetitions_by if rx.search(workload)), a.repetitions)
 
 
 def _exe() -> str:
@@ -186,6 +227,8 @@ def run(a) -> int:
         finally:
             shutil.rmtree(work, ignore_errors=True)
     run_devs, skipped_devs = devices.plan(exe, a.devices)
+    if a.crosscheck:
+        return _crosscheck(a, exe, out, chosen, run_devs, skipped_devs)
     rank, size = devices.mpi_world()
     data = manifest.data_dir()
     runnable, skipped_rows = [], []
@@ -210,6 +253,48 @@ def run(a) -> int:
         shutil.rmtree(work, ignore_errors=True)
 
 
+def _crosscheck(a, exe, out, chosen, run_devs, skipped_devs) -> int:
+    """--crosscheck: every chosen workload on every device against Mitsuba 3; exit 0 when all
+    pass, 1 when one does not (or could not be judged)."""
+    for d in skipped_devs:
+        print(f"pathbench suite: no {d['label']}: {d['reason']}", file=sys.stderr)
+    data = manifest.data_dir()
+    runnable = []
+    for w in chosen:
+        why = manifest.missing_requirement(w, data)
+        if why:
+            print(f"pathbench suite: skipped {w['name']}: {why}", file=sys.stderr)
+        else:
+            runnable.append(w)
+    work = _work_dir(out)
+    try:
+        t0 = time.monotonic()
+        with open(os.path.join(work, "crosscheck.log"), "w") as log:
+            rows = crosscheck.run(exe, runnable, run_devs, a.crosscheck_frame, a.crosscheck_spp, a.mitsuba_variant,
+                                  work, log)
+        version = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout.strip().splitlines()
+        gpus = sorted({d["name"] for d in run_devs if d["device"] == "gpu"})
+        facts = [("date", dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")),
+                 ("pathbench", version[0] if version else "?"), ("devices", ", ".join(d["label"] for d in run_devs)),
+                 ("GPU", ", ".join(gpus) or "none"), ("took", f"{(time.monotonic() - t0) / 60:.1f} min")]
+        doc = {"suite": "pathbench", "command": "pathbench suite " + " ".join(sys.argv[1:]), "facts": facts,
+               "frame": list(a.crosscheck_frame), "spp": a.crosscheck_spp, "mitsuba_variant": a.mitsuba_variant,
+               "rows": rows}
+        with open(os.path.join(work, "crosscheck.json"), "w") as f:
+            json.dump(_finite(doc), f, indent=1, allow_nan=False)
+            f.write("\n")
+        with open(os.path.join(work, "crosscheck.md"), "w") as f:
+            f.write(crosscheck.markdown(rows, a.crosscheck_frame, a.crosscheck_spp, a.mitsuba_variant, facts))
+        os.makedirs(out, exist_ok=True)
+        for n in os.listdir(work):
+            os.replace(os.path.join(work, n), os.path.join(out, n))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    bad = [r for r in rows if r["status"] != "pass"]
+    print(f"crosscheck: {len(rows) - len(bad)} of {len(rows)} pass; {os.path.join(out, 'crosscheck.md')}")
+    return 1 if bad or not rows else 0
+
+
 def _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_rows, mode, preset, db, stamp, rank, size, t0):
     groups = [[d] for d in run_devs]
     if size > 1:  # under mpirun: one pathbench-bench for every device, its frames over the ranks
@@ -219,22 +304,27 @@ def _run_in(a, work, out, exe, bench, m, runnable, chosen, run_devs, skipped_row
         cases, label = [], "-".join(d["label"] for d in g)
         for d in g:
             cases += runner.cases_for(runnable, d, a.quick, a.isa, manifest.data_dir())
-        plans.append((g, label, cases))
-    total = sum(len(c) for _, _, c in plans) * a.repetitions
+        # One pathbench-bench per repetition count (--repetitions-for), so that every benchmark
+        # keeps its name (Google Benchmark would append /repeats:N to a per-benchmark count).
+        counts = sorted({repetitions_of(a, c["workload"]) for c in cases}, reverse=True) or [a.repetitions]
+        for n in counts:
+            part = [c for c in cases if repetitions_of(a, c["workload"]) == n]
+            plans.append((g, label if n == counts[0] else f"{label}-r{n}", part, n))
+    total = sum(len(cs) * n for _, _, cs, n in plans)
     progress = runner.Progress(total)
     rows, bench_files, ctx = list(skipped_rows), [], {}
     with open(os.path.join(work, "bench.log"), "w") as log:
-        for g, label, cases in plans:
+        for g, label, cases, reps in plans:
             if not cases:
                 continue
             min_time = a.min_time or (1.0 if any(d["device"] == "gpu" for d in g) else (0.1 if a.quick else 0.5))
             doc = {"suite": "pathbench", "version": m["version"], "mode": mode, "manifest_sha256": m["sha256"],
-                   "device_label": label, "cases": [{k: c[k] for k in ("name", "scene", "device", "settings")} |
-                                                    ({"iterations": c["iterations"]} if "iterations" in c else {})
-                                                    for c in cases]}
+                   "device_label": "-".join(d["label"] for d in g),
+                   "cases": [{k: c[k] for k in ("name", "scene", "device", "settings", "iterations") if k in c}
+                             for c in cases]}
             env = dict(g[0]["env"]) if len(g) == 1 else {}
             env["PATHBENCH_DATA_DIR"] = manifest.data_dir()
-            rc, path = runner.run_device(bench, doc, work, label, a.repetitions, min_time, env, progress, log)
+            rc, path = runner.run_device(bench, doc, work, label, reps, min_time, env, progress, log)
             if rank != 0:
                 continue
             if rc == 2:
@@ -299,16 +389,16 @@ def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t
         _record(db, bench_files, a)
         prev = results.previous_runs(db, [os.path.basename(f) for f in bench_files], preset)
         for r in rows:
-            p = prev.get(r.get("benchmark", ""))
+            p = prev.get(results.series(r.get("benchmark", "")))
             if p and r["status"] == "ok":
                 r["previous"] = results.verdict(r["times_ms"], p["times_ms"]) | {"run_date": p["run_date"],
                                                                                  "commit": p["commit"]}
     sources = {os.path.basename(f) for f in bench_files}
     refs = results.reference_runs(a.references, preset, sources) if a.references and os.path.isdir(a.references) else {}
-    ref_names = sorted(n for n, per in refs.items() if any(r.get("benchmark") in per for r in rows))
+    ref_names = sorted(n for n, per in refs.items() if any(results.series(r.get("benchmark", "")) in per for r in rows))
     for r in rows:
         for n in ref_names:
-            ref = refs[n].get(r.get("benchmark", ""))
+            ref = refs[n].get(results.series(r.get("benchmark", "")))
             if ref:
                 r.setdefault("references", {})[n] = {"ms": results._median(ref["times_ms"]), "run_date": ref["run_date"],
                                                      "commit": ref["commit"]}
@@ -330,7 +420,10 @@ def _report(a, work, out, m, chosen, rows, bench_files, ctx, mode, preset, db, t
                                   instanced_triangles=max(w["instanced_triangles"],
                                                           manifest.triangle_estimate(w, manifest.data_dir(), a.quick)[1]))
                              for w in chosen]}
-    summary["facts"] = _facts(summary, ctx, None if t0 is None else time.monotonic() - t0, a.repetitions)
+    fewer = sorted({f"{r['workload']} {r['repetitions']}" for r in rows
+                    if r["status"] == "ok" and r.get("repetitions", a.repetitions) < a.repetitions})
+    summary["facts"] = _facts(summary, ctx, None if t0 is None else time.monotonic() - t0,
+                              a.repetitions if not fewer else f"{a.repetitions} (fewer: {', '.join(fewer)})")
     summary = _finite(summary)
     with open(os.path.join(work, "suite.json"), "w") as f:
         json.dump(summary, f, indent=1, allow_nan=False)

@@ -33,7 +33,7 @@ def _mb(v):
     return "–" if not v else f"{v / 2**20:,.0f}"
 
 
-def _cells(r: dict, ref_names: list[str]) -> list[tuple[str, str, str]]:
+def _cells(r: dict, ref_names: list[str], reps: int = 9) -> list[tuple[str, str, str]]:
     """(text, css class, title) per column of a row that ran."""
     prev = r.get("previous") or {}
     if prev.get("verdict") in ("faster", "slower", "same"):
@@ -46,7 +46,7 @@ def _cells(r: dict, ref_names: list[str]) -> list[tuple[str, str, str]]:
                                               if r.get("energy_busy_fraction") is not None else "")
     if r.get("joules_per_frame") is None:
         energy = "n/a"
-    elif (r.get("energy_busy_fraction") or 1) < 0.5:  # the window was mostly BVH builds between frames
+    elif (r.get("energy_busy_fraction") or 1) < 0.5:  # the window was mostly work between frames
         energy += f" ({r['energy_busy_fraction'] * 100:.0f}% frame)"
     if r.get("throttled") is None:
         clocks = ("–", "", "")
@@ -54,10 +54,13 @@ def _cells(r: dict, ref_names: list[str]) -> list[tuple[str, str, str]]:
         state = "THROTTLED" if r["throttled"] else "ok"
         clocks = (f"{_num(r.get('sm_clock_mhz'), 4)} MHz, {_num(r.get('temperature_c_max'), 3)} °C, {state}",
                   "warn" if r["throttled"] else "", f"clock-event reasons 0x{r.get('throttle_reasons') or 0:x}")
-    cells = [(_num(r.get("ms"), 4), "", f"median of {r.get('repetitions')} repetitions"),
+    n = r.get("repetitions") or reps
+    cells = [(_num(r.get("ms"), 4) + (f" (n={n})" if n < reps else ""), "", f"median of {n} repetitions"),
              (_num(r.get("rays_per_second"), 4, 1e-6), "", ""),
              (_num(r.get("samples_per_second"), 4, 1e-6), "", ""),
              (f"{_mb(r.get('peak_host_bytes'))} / {_mb(r.get('peak_device_bytes'))}", "", "host / device MiB"),
+             (_num(r.get("build_seconds"), 3), "", "the scene's acceleration structure, built once per benchmark "
+              "(not in the frame time or the energy)"),
              (energy, "" if r.get("joules_per_frame") is not None else "skip", energy_title),
              (_num(r.get("rays_per_joule"), 4, 1e-6), "", ""), clocks,
              ((r.get("film_hash") or "–").replace("fnv1a64:", ""), "mono", r.get("film_hash") or ""), vs_prev]
@@ -72,7 +75,7 @@ def _cells(r: dict, ref_names: list[str]) -> list[tuple[str, str, str]]:
     return cells
 
 
-HEAD = ["workload", "device", "ms / frame", "Mrays/s", "Msamples/s", "peak MiB", "J / frame", "Mrays / J",
+HEAD = ["workload", "device", "ms / frame", "Mrays/s", "Msamples/s", "peak MiB", "build s", "J / frame", "Mrays / J",
         "SM clock, temp, throttle", "film hash", "vs previous run"]
 
 
@@ -108,16 +111,18 @@ def write_html(path: str, s: dict) -> None:
         if r["status"] != "ok":
             h.append(f'<td class="l skip" colspan="{len(HEAD) - 2 + len(refs)}">skipped: {e(r.get("reason", ""))}</td></tr>')
             continue
-        for i, (text, cls, title) in enumerate(_cells(r, refs)):
+        for i, (text, cls, title) in enumerate(_cells(r, refs, s.get("repetitions", 9))):
             bar = ""
             if i == 1 and r.get("rays_per_second"):
                 bar = f'<span class="bar" style="width:{max(1, int(60 * r["rays_per_second"] / best))}px"></span>'
             h.append(f'<td class="{e(cls)}" title="{e(title)}">{bar}{e(text)}</td>')
         h.append("</tr>")
     h.append("</tbody></table>")
-    h.append("<p class=facts>Times are the median over the repetitions (compare's U test needs ≥ 9). Energy: NVML on "
-             "GPUs, RAPL on CPUs where readable, over each repetition's frames (the BVH build between frames "
-             "included; hover for the busy fraction); n/a with the reason where the counter cannot be read. "
+    h.append("<p class=facts>Times are the median over the repetitions (compare's U test needs ≥ 9; n= marks a "
+             "row with fewer). The scene's acceleration structure is built once per benchmark (build s) and "
+             "neither its time nor its energy is in the frame's. Energy: NVML on GPUs, RAPL on CPUs where "
+             "readable, over each repetition's frames (hover for the busy fraction: the frames' share of the "
+             "window); n/a with the reason where the counter cannot be read. "
              "vs previous: this machine's latest earlier run in the history database, judged as "
              "<code>pathbench compare</code> does (Mann-Whitney U, p &lt; 0.05 and more than 5 %). Reference "
              "columns: that machine's median time and how many times as fast this machine is.</p>")
@@ -161,7 +166,8 @@ def write_markdown(path: str, s: dict) -> None:
         if r["status"] != "ok":
             m.append(f"| {_md(r['workload'])} | {_md(dev)} | skipped: {_md(r.get('reason', ''))} |" + " |" * (len(HEAD) - 3 + len(refs)))
             continue
-        m.append(f"| {_md(r['workload'])} | {_md(dev)} | " + " | ".join(_md(c[0]) for c in _cells(r, refs)) + " |")
+        m.append(f"| {_md(r['workload'])} | {_md(dev)} | " +
+                 " | ".join(_md(c[0]) for c in _cells(r, refs, s.get("repetitions", 9))) + " |")
     notes = sorted({(r["device"], r["energy_reason"]) for r in s["rows"] if r.get("energy_reason")})
     if notes:
         m += ["", "Energy not measured:"] + [f"- {_md(d)}: {_md(why)}" for d, why in notes]

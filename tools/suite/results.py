@@ -26,6 +26,13 @@ def _time_ms(row: dict) -> float | None:
     return t * scale if isinstance(t, (int, float)) and scale else None
 
 
+def series(benchmark: str) -> str:
+    """A benchmark's series across runs: its name without Google Benchmark's /iterations:N (a
+    fixed iteration count, which the suite's large workloads had while every frame rebuilt
+    the BVH) and /manual_time."""
+    return re.sub(r"(/iterations:\d+)?(/manual_time)?$", "", benchmark)
+
+
 def rows_from_bench(doc: dict, cases: list[dict], device: dict) -> list[dict]:
     """One row per case: medians over the repetitions, or status 'failed' with the error."""
     ctx = doc.get("context", {})
@@ -36,8 +43,7 @@ def rows_from_bench(doc: dict, cases: list[dict], device: dict) -> list[dict]:
     full: dict[str, str] = {}  # case name -> the JSON's (and the history's) name: ".../manual_time"
     for b in doc.get("benchmarks", []):
         name = b.get("run_name", b.get("name", ""))
-        # Google Benchmark appends /iterations:N (a fixed count: large scenes) and /manual_time.
-        short = re.sub(r"(/iterations:\d+)?(/manual_time)?$", "", name)
+        short = series(name)
         full[short] = name
         name = short
         if b.get("error_occurred"):
@@ -80,7 +86,8 @@ def rows_from_bench(doc: dict, cases: list[dict], device: dict) -> list[dict]:
             energy_reason=None if med("energy_joules_per_frame") is not None else no_energy.get(c["name"]),
             sm_clock_mhz=med("sm_clock_mhz_mean"), temperature_c_max=peak("temperature_c_max"),
             throttled=throttled, throttle_reasons=reasons if throttled is not None else None,
-            triangles=med("triangles"), isa=isa, film_hash=hashes.get(c["name"]))
+            triangles=med("triangles"), isa=isa, film_hash=hashes.get(c["name"]),
+            build_seconds=med("build_seconds"))
         out.append(base)
     return out
 
@@ -150,9 +157,9 @@ def previous_runs(db_path: str, sources: list[str], preset: str) -> dict[str, di
     for bench, value, unit, run_id, date, commit in rows:
         if unit != "ms" or not isinstance(value, (int, float)):
             continue
-        cur = latest.get(bench)
+        cur = latest.get(series(bench))
         if cur is None or run_id > cur["run_id"]:
-            latest[bench] = cur = {"run_id": run_id, "run_date": date, "commit": commit, "times_ms": []}
+            latest[series(bench)] = cur = {"run_id": run_id, "run_date": date, "commit": commit, "times_ms": []}
         if run_id == cur["run_id"]:
             cur["times_ms"].append(value)
     return latest
@@ -175,9 +182,9 @@ def reference_runs(export_dir: str, preset: str, exclude_sources=()) -> dict[str
                     r = json.loads(line)
                     if r.get("unit") != "ms" or not isinstance(r.get("value"), (int, float)):
                         continue
-                    cur = per.get(r["benchmark"])
+                    cur = per.get(series(r["benchmark"]))
                     if cur is None or date > cur["run_date"]:
-                        per[r["benchmark"]] = cur = {"run_date": date, "commit": head.get("commit", ""), "times_ms": [],
+                        per[series(r["benchmark"])] = cur = {"run_date": date, "commit": head.get("commit", ""), "times_ms": [],
                                                      "counters": r.get("counters") or {}}
                     if date == cur["run_date"]:
                         cur["times_ms"].append(r["value"])

@@ -11,7 +11,6 @@ import time
 from . import manifest
 
 AGGREGATES = ("_mean", "_median", "_stddev", "_cv")
-BIG_SCENE = 1_000_000  # triangles of the flat BVH: every iteration rebuilds it, so few iterations
 
 
 def strategy_of(settings: dict) -> str:
@@ -32,8 +31,6 @@ def cases_for(workloads: list[dict], device: dict, quick: bool, isa: str | None,
             s.pop("isa", None)
         c = {"workload": w["name"], "name": case_name(w, device["label"], s),
              "scene": manifest.scene_of(w, quick), "device": device["device"], "settings": s}
-        if max(manifest.triangle_estimate(w, data, quick)) >= BIG_SCENE:
-            c["iterations"] = 1  # every iteration builds the BVH again: seconds for these
         cases.append(c)
     return cases
 
