@@ -30,7 +30,10 @@
 namespace pb::cpu {
 
 namespace {
-constexpr uint32_t kTile = 16;
+// Tiles of 8 x 8 pixels: at 16 tiles a thread (16 x 16, 256x256 on 16 cores) the last tiles
+// left up to 7% of the threads' time idle at the frame's end (stage timers on the GPU host's
+// Xeon); at 64 a thread, ~1% (docs/notes/cpu-log.md, 2026-11-27).
+constexpr uint32_t kTile = 8;
 
 struct Local {
   RayCounts rays;
