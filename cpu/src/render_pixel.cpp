@@ -11,12 +11,15 @@
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <memory>
 #include <type_traits>
 
 #include "embree_rays.h"
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
+#include "stage_timers.h"
 #include "strategies.h"
 #include "tiny_scene.h"
 
@@ -27,7 +30,16 @@
 namespace pb::cpu {
 
 namespace {
-constexpr uint32_t kTile = 16;
+// Tiles of 8 x 8 pixels: at 16 tiles a thread (16 x 16, 256x256 on 16 cores) the last tiles
+// left up to 7% of the threads' time idle at the frame's end (stage timers on the GPU host's
+// Xeon); at 64 a thread, ~1% (docs/notes/cpu-log.md, 2026-11-27).
+constexpr uint32_t kTile = 8;
+// The final vertex's shadow rays go through the tiny test only where a batch has at least this
+// many: a tiny test costs about a full packet whatever its fill (~2,300 instructions at 8 lanes,
+// ~400 ns at 16 on the Xeon), one rtcOccluded1 ~800 instructions (~80-100 ns); a batch's last
+// vertex mostly has 0-2 (callgrind: tiny test for every one, 1681 instructions a sample against
+// 1653 with single rays only).
+constexpr int kTinyFinalMin = 4;
 
 struct Local {
   RayCounts rays;
@@ -97,7 +109,10 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
   }
   float* hit_rays[6];
   packet_arrays(packets.hit.ray, hit_rays);
-  k.begin_paths(job.scene, job.config, pixels, samples, lanes, count, hit_rays);
+  {
+    PB_STAGE(kCamera);
+    k.begin_paths(job.scene, job.config, pixels, samples, lanes, count, hit_rays);
+  }
   // The shading's streams: next rays into the hit packet, shadow rays into the shadow
   // packet; tags are indices into st.
   uint32_t live[W], shadowed[W];
@@ -114,23 +129,52 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     const uint32_t depth = st[live[0]].depth;  // every live sample's
     if (path_at_final_vertex(job.scene, job.config, st[live[0]])) {
       // The emitter screen, then path_final_query (trace_path's first step); the paths end.
+      PB_STAGE(kFinal);
       PathState<float>* at_final[W];
       for (int j = 0; j < W; ++j) at_final[j] = &st[live[j < n_live ? j : 0]];
       bool candidate[W];
       k.final_vertex_candidates(job.scene, at_final, candidate);
-      for (int j = 0; j < n_live; ++j) {
-        ShadowQuery<float> q;
-        PathState<float>& s = st[live[j]];
-        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, s, q)) {
-          count_ray(local.rays, depth, &RayCounts::shadow);
-          if (!occluded(job.embree, ctx, q.ray, 1.0f)) shadow_unoccluded(s, q);
+      // The emitter queries' shadow rays: one tiny test for all of them where there is one
+      // and they are enough to pay for it (kTinyFinalMin; a proven answer is Embree's), each
+      // unsure one (and every one otherwise) through the single-ray rtcOccluded1 this step
+      // always made, so every ray gets the answer it got before (docs/notes/cpu-log.md,
+      // 2026-11-27).
+      ShadowQuery<float> q[W];
+      uint32_t of[W];  // the query's sample
+      int n_q = 0;
+      for (int j = 0; j < n_live; ++j)
+        if (candidate[j] && path_final_query<kDiffuseOnly>(job.scene, job.config, st[live[j]], q[n_q])) {
+          const Ray<float>& r = q[n_q].ray;
+          packets.shadow.org_x[n_q] = r.o.x; packets.shadow.org_y[n_q] = r.o.y; packets.shadow.org_z[n_q] = r.o.z;
+          packets.shadow.dir_x[n_q] = r.d.x; packets.shadow.dir_y[n_q] = r.d.y; packets.shadow.dir_z[n_q] = r.d.z;
+          of[n_q++] = live[j];
         }
+      if (n_q > 0) {
+        (depth == 0 ? local.rays.camera : local.rays.shadow) += uint64_t(n_q);  // count_ray, per query
+        bool blocked[W];
+        uint32_t unsure = (uint32_t(1) << n_q) - 1;
+        if (tiny && n_q >= kTinyFinalMin) {
+          PB_STAGE(kShadow);
+          float* rays[6];
+          packet_arrays(packets.shadow, rays);
+          unsure &= k.tiny_occluded(*tiny, rays, packets.shadow.tfar, blocked);  // tfar: 1 (PixelPackets)
+        }
+        for (; unsure != 0; unsure &= unsure - 1) {
+          PB_STAGE(kShadowEmbree);
+          const int i = __builtin_ctz(unsure);
+          blocked[i] = occluded(job.embree, ctx, q[i].ray, 1.0f);
+        }
+        for (int i = 0; i < n_q; ++i)
+          if (!blocked[i]) shadow_unoccluded(st[of[i]], q[i]);
       }
       break;
     }
     // Closest hits (one packet); misses end their paths.
     uint32_t hit[W];
-    closest_hits<W>(k, tiny, job.embree, ctx, hit_rays, packets.hit, n_live, hit);  // tfar, geomID: PixelPackets
+    {
+      PB_STAGE(kClosest);
+      closest_hits<W>(k, tiny, job.embree, ctx, hit_rays, packets.hit, n_live, hit);  // tfar, geomID: PixelPackets
+    }
     (depth == 0 ? local.rays.camera : local.rays.bounce) += uint64_t(n_live);
     ShadeBatch batch;
     batch.lanes = 0;
@@ -150,11 +194,15 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     next.n = shadow.n = 0;
     batch.next = &next;
     batch.shadow = &shadow;
-    k.shade_diffuse(job.scene, job.config, table, batch);
+    {
+      PB_STAGE(kShade);
+      k.shade_diffuse(job.scene, job.config, table, batch);
+    }
     if (shadow.n > 0) {
       const int n_shadowed = int(shadow.n);
       local.rays.shadow += uint64_t(n_shadowed);  // depth >= 0 here: never a camera ray
       bool blocked[W];
+      PB_STAGE(kShadow);
       shadows_blocked<W>(k, tiny, job.embree, ctx, shadow.ray, packets.shadow, n_shadowed, blocked);  // tfar: 1
       for (int j = 0; j < n_shadowed; ++j)
         if (!blocked[j]) {
@@ -164,6 +212,7 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
     }
     n_live = int(next.n);
   }
+  PB_STAGE(kFilm);
   for (int i = 0; i < count; ++i) {
     ++local.paths;
     if (!job.film.add(pixel, Vec3f(st[i].L))) ++local.discarded;
@@ -188,7 +237,13 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
   const std::unique_ptr<TinyScene> tiny = tiny_scene_for(job.embree, job.scene, k);
   const uint32_t w = job.config.width, y0 = job.config.first_pixel / w;
   tbb::combinable<Local> locals;
-  tbb::parallel_for(tbb::blocked_range2d<uint32_t>(y0, y0 + job.rows, kTile, 0, w, kTile), [&](const auto& tile) {
+  PB_STAGE_RENDER("pixel", tbb::this_task_arena::max_concurrency());
+  uint32_t tile_size = kTile;
+#if defined(PB_STAGE_TIMERS) && PB_STAGE_TIMERS
+  if (const char* e = std::getenv("PB_PIXEL_TILE")) tile_size = uint32_t(std::max(1, std::atoi(e)));  // profiling only
+#endif
+  tbb::parallel_for(tbb::blocked_range2d<uint32_t>(y0, y0 + job.rows, tile_size, 0, w, tile_size), [&](const auto& tile) {
+    PB_STAGE_THREAD();
     Local& local = locals.local();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "pathbench/common/errors.h"
+#include "stage_timers.h"
 #include "strategies.h"
 #include "tiny_scene.h"
 #include "wavefront_pool.h"
@@ -47,7 +48,9 @@ TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const Batch
                                  paths_in_flight, pool_bytes / 1e9, memory / 1e9));
   const std::unique_ptr<TinyScene> tiny = tiny_scene_for(job.embree, job.scene, k);
   tbb::combinable<Local> locals;
+  PB_STAGE_RENDER("wavefront", slices);
   tbb::parallel_for(0, slices, [&](int) {
+    PB_STAGE_THREAD();
     auto slice = std::make_unique<Slice<T, Kinds, W>>(job, k, table.get(), tiny.get(), source, per_slice, locals.local());
     slice->run();
   }, tbb::static_partitioner());

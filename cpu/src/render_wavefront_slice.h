@@ -30,6 +30,7 @@
 #include "film_combiner.h"
 #include "pathbench/common/path.h"
 #include "shade_batch.h"
+#include "stage_timers.h"
 #include "strategies.h"
 #include "tiny_scene.h"
 #include "wavefront_pool.h"
@@ -80,6 +81,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
  private:
   // Free slots get new samples: `live`, or `final` where a path's first vertex is its last.
   PB_CPU_FLATTEN void generate() {
+    PB_STAGE(kCamera);
     uint64_t n = pool_.n_free;
     if (n == 0) return;
     const uint64_t start = src_.claim(n);
@@ -136,6 +138,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
   // runs only for the lanes that may have one, and gives every path what it would have
   // given it anyway.
   PB_CPU_FLATTEN void final_vertex() {
+    PB_STAGE(kFinal);
     const uint32_t n = pool_.n_final;
     pool_.n_final = 0;
     auto query = [&](uint32_t slot) {
@@ -208,6 +211,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
     if (k_) {
       const float* rays[6];
       for (int j = 0; j < 6; ++j) rays[j] = pool_.ray[j].data() + base;
+      PB_STAGE(kClosest);
       closest_hits<W>(*k_, tiny_, job_.embree, ctx_, rays, hit_packet_, n, prim);
       return;
     }
@@ -282,7 +286,10 @@ template <class T, uint32_t Kinds, int W> class Slice {
       b.next = &next;
       b.final = &to_final;
       b.shadow = &shadow;
-      k_->shade_diffuse(job_.scene, job_.config, *table_, b);
+      {
+        PB_STAGE(kShade);
+        k_->shade_diffuse(job_.scene, job_.config, *table_, b);
+      }
       b.lanes = 0;
       keep_ = next.n;
       pool_.n_final = to_final.n;
@@ -309,6 +316,7 @@ template <class T, uint32_t Kinds, int W> class Slice {
     const float* rays[6];
     for (int j = 0; j < 6; ++j) rays[j] = sb.ray[j];
     bool blocked[W];  // tfar holds 1 here (reset_packet after each Embree call)
+    PB_STAGE(kShadow);
     if (k_) {
       shadows_blocked<W>(*k_, tiny_, job_.embree, ctx_, rays, p, n, blocked);
     } else {

@@ -26,6 +26,7 @@
 #include "pathbench/common/scene.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "shade_batch.h"
+#include "stage_timers.h"
 
 namespace pb::cpu {
 
@@ -132,6 +133,7 @@ int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e
                  const float* const* rays, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
   uint32_t unsure = k.tiny_closest(t, rays, p.ray.tfar, prim) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
+  PB_STAGE(kClosestEmbree);
   copy_rays<W>(rays, p.ray);
   intersect_packet(n, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i)
@@ -147,6 +149,7 @@ int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& 
                   const float* const* rays, RTCRayNt<W>& p, int n, bool* blocked) {
   uint32_t unsure = k.tiny_occluded(t, rays, p.tfar, blocked) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
+  PB_STAGE(kShadowEmbree);
   copy_rays<W>(rays, p);
   occluded_packet(n, e.handle(), &ctx, p);
   for (int i = 0; i < n; ++i)
