@@ -38,16 +38,34 @@ template <class T> PB_HD Vec3<T>& operator*=(Vec3<T>& a, Vec3<T> b) { a = a * b;
 template <class T> PB_HD Vec3<T>& operator*=(Vec3<T>& a, T s) { a = a * s; return a; }
 
 // a * b + c with one rounding, the same bits on every device: fmaf / fma on the GPU,
-// the FMA instruction on a host compiled for it (-mfma, -march=native), std::fma (libm,
-// correctly rounded; glibc's picks the FMA instruction at load time where the CPU has it)
-// otherwise. The path step uses it where a multiply feeds an add; the CPU's vector path
-// step (cpu/src/simd8.h) fuses exactly the same operations, so its lanes keep the scalar
-// bits. Never left to the compiler: -ffp-contract=off and --fmad=false.
+// the FMA instruction on a host compiled for it (-mfma, -march=native). In a portable
+// x86-64 build (SSE2 baseline) the FMA instruction inline where the CPU has it, checked
+// once at start-up (a predicted branch: std::fma alone is a call into libm per use, whose
+// spills made the scalar path step 11% more instructions), else std::fma (libm, correctly
+// rounded: the same bits). The path step uses it where a multiply feeds an add; the CPU's
+// vector path step (cpu/src/simd8.h) fuses exactly the same operations, so its lanes keep
+// the scalar bits. Never left to the compiler: -ffp-contract=off and --fmad=false.
+#if !defined(__CUDA_ARCH__) && !defined(__FMA__) && defined(__x86_64__) && defined(__GNUC__)
+#define PB_HOST_FMA_DISPATCH 1
+namespace detail {
+// False until set during static initialisation (a use before that takes std::fma).
+inline const bool kHostHasFma = [] {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("fma") != 0;
+}();
+}  // namespace detail
+#endif
 PB_HD float fmadd(float a, float b, float c) {
 #if defined(__CUDA_ARCH__)
   return fmaf(a, b, c);
 #elif defined(__FMA__)
   return __builtin_fmaf(a, b, c);
+#elif defined(PB_HOST_FMA_DISPATCH)
+  if (__builtin_expect(detail::kHostHasFma, 1)) {
+    __asm__("vfmadd213ss %2, %1, %0" : "+x"(a) : "x"(b), "x"(c));  // a = b * a + c
+    return a;
+  }
+  return std::fma(a, b, c);
 #else
   return std::fma(a, b, c);
 #endif
@@ -57,6 +75,12 @@ PB_HD double fmadd(double a, double b, double c) {
   return fma(a, b, c);
 #elif defined(__FMA__)
   return __builtin_fma(a, b, c);
+#elif defined(PB_HOST_FMA_DISPATCH)
+  if (__builtin_expect(detail::kHostHasFma, 1)) {
+    __asm__("vfmadd213sd %2, %1, %0" : "+x"(a) : "x"(b), "x"(c));
+    return a;
+  }
+  return std::fma(a, b, c);
 #else
   return std::fma(a, b, c);
 #endif
