@@ -53,7 +53,7 @@ struct ShadeBatch {
 // lanes load it with three 8x8 transposes instead of ~20 scalar loads each:
 //   row 0: v0.xyz, e1.xyz, e2.xy     row 1: e2.z, ng.xyz, albedo.xyz, emits
 //   row 2: emission.xyz, scatters, 0 x 4
-// e1 = v1 - v0, e2 = v2 - v0 and ng = normalize(cross(e1, e2)) are computed exactly as
+// e1 = v1 - v0, e2 = v2 - v0 and ng = fnormalize(fcross(e1, e2)) are computed exactly as
 // surface_hit and path_hit compute them (same float operations, so the same bits);
 // `emits` and `scatters` are masks (-1 or 0): emission nonzero, albedo nonzero.
 // 96 bytes a triangle: built only for scenes up to kMaxTriangles (the rest shade one
@@ -70,7 +70,7 @@ struct ShadeTable {
       const Vec3f v0 = s.positions[tri.v[0]];
       const Vec3f e1 = s.positions[tri.v[1]] - v0;
       const Vec3f e2 = s.positions[tri.v[2]] - v0;
-      const Vec3f ng = normalize(cross(e1, e2));
+      const Vec3f ng = fnormalize(fcross(e1, e2));
       const Material& m = s.material_of(t);
       const int32_t emits = is_zero(m.emission) ? 0 : -1, scatters = is_zero(m.albedo) ? 0 : -1;
       float* r = &rows[size_t(t) * kRowFloats];

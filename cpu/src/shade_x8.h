@@ -128,21 +128,23 @@ inline void pick_emitters(const SceneView& s, IV pick, FV& u, UV& light) {
   const V3 le_light{lc[0], lc[1], lc[2]};
 
   // surface_hit (surface_hit.h).
-  const V3 pv = cross(d, e2);
-  const FV inv_det = 1.0f / dot(e1, pv);
+  const V3 pv = fcross(d, e2);
+  const FV inv_det = 1.0f / fdot(e1, pv);
   const V3 tv = o - v0;
-  FV b1 = dot(tv, pv) * inv_det;
-  const V3 qv = cross(tv, e1);
-  FV b2 = dot(d, qv) * inv_det;
-  const FV t = dot(e2, qv) * inv_det;
+  FV b1 = fdot(tv, pv) * inv_det;
+  const V3 qv = fcross(tv, e1);
+  FV b2 = fdot(d, qv) * inv_det;
+  const FV t = fdot(e2, qv) * inv_det;
   b1 = vmin(vmax(b1, FV{}), splat(1.0f));
   b2 = vmin(vmax(b2, FV{}), 1.0f - b1);
-  const V3 p = v0 + e1 * b1 + e2 * b2;
+  const V3 p = madd(e2, b2, madd(e1, b1, v0));
 
   // 1. Emission, MIS-weighted after the first vertex (emitted_radiance).
-  const FV cos_o = -dot(ng, d);
-  const FV pdf_e = mean3(Le) / s.emitter_power_total * t * t / cos_o;
-  const FV w_e = select(mis_e, power_heuristic(bsdf_pdf, pdf_e), splat(1.0f));
+  const FV cos_o = -fdot(ng, d);
+  const FV a_e = bsdf_pdf * cos_o, pa_e = mean3(Le) / s.emitter_power_total * (t * t);
+  const FV a2_e = a_e * a_e;
+  const FV mis_w = select(a2_e > 0.0f, a2_e / madd(pa_e, pa_e, a2_e), splat(0.0f));
+  const FV w_e = select(mis_e, mis_w, splat(1.0f));
   L = select((cos_o > 0.0f) & emits, L + beta * Le * w_e, L);
 
   // 2.-5. For the lanes that scatter.
@@ -156,37 +158,41 @@ inline void pick_emitters(const SceneView& s, IV pick, FV& u, UV& light) {
   if (nee) {
     const FV su = sqrt(u_pick);
     const FV tb1 = 1.0f - su, tb2 = u3 * su;
-    const V3 y = l0 + le1 * tb1 + le2 * tb2;
+    const V3 y = madd(le2, tb2, madd(le1, tb1, l0));
     V3 wi = y - p;
-    const FV dist2 = dot(wi, wi);
-    wi = wi / sqrt(dist2);
-    const FV cos_s = dot(n, wi);
-    const FV cos_l = -dot(nl, wi);
+    const FV dist2 = fdot(wi, wi);
+    wi = wi * (1.0f / sqrt(dist2));
+    const FV cos_s = fdot(n, wi);
+    const FV cos_l = -fdot(nl, wi);
     shadow = scatters & (cos_s > 0.0f) & (cos_l > 0.0f) & (dist2 > 0.0f);
-    const FV pdf_light = mean3(le_light) / s.emitter_power_total * dist2 / cos_l;
     const V3 f = albedo * splat(kInvPi<float>);
     const FV f_pdf = vmax(cos_s, FV{}) * kInvPi<float>;
-    const FV w = power_heuristic(pdf_light, f_pdf);
-    contribution = beta * f * le_light * (cos_s * w / pdf_light);
+    const FV pa = mean3(le_light) / s.emitter_power_total * dist2;
+    const FV fc = f_pdf * cos_l;
+    const FV k = cos_s * cos_l * pa / madd(pa, pa, fc * fc);
+    contribution = beta * f * le_light * k;
     shadow_d = offset_ray_origin(y, nl, s.offset) - origin;
   }
 
   // 4. Next direction: lambert_sample (bsdf/lambert.h).
   FV r, z, pdf;
+  V3 weight;
   if (c.sampling == Sampling::Uniform) {
     z = u0;
-    r = sqrt(vmax(FV{}, 1.0f - z * z));
+    r = sqrt(vmax(FV{}, madd(-z, z, 1.0f)));
     pdf = splat(uniform_hemisphere_pdf<float>());
+    weight = albedo * (2.0f * z);
   } else {
     r = sqrt(u0);
     z = sqrt(vmax(FV{}, 1.0f - u0));
     pdf = vmax(z, FV{}) * kInvPi<float>;
+    weight = albedo;
   }
   FV sin_phi, cos_phi;
   sincos_turns(u1, sin_phi, cos_phi);
   const V3 local{r * cos_phi, r * sin_phi, z};
   IV cont = scatters & (pdf > 0.0f) & (z > 0.0f);
-  V3 beta_next = beta * (albedo * splat(kInvPi<float>) * (z / pdf));
+  V3 beta_next = beta * weight;
   const V3 wi_next = frame.to_world(local);
 
   // 5. Russian roulette.
@@ -199,7 +205,7 @@ inline void pick_emitters(const SceneView& s, IV pick, FV& u, UV& light) {
       const RngStream rng{uint32_t(pixel[i]), c.seed};
       if (!(rng.draw(uint32_t(sample[i]), uint32_t(vertex[i]), kRngRoulette).v[0] < q[i])) cont[i] = 0;
     }
-    beta_next = select(rr, beta_next / q, beta_next);
+    beta_next = select(rr, beta_next * (1.0f / q), beta_next);
   }
 
   // Back to the states: radiance always, the rest where the path goes on.
@@ -324,12 +330,13 @@ inline void begin_paths(const SceneView& s, const PathConfig& c, const uint32_t*
   rng_draw(pix, c.seed, smp, UV{}, kRngCamera, u);
   const Camera& cam = s.camera;
   const float w = float(c.width), h = float(c.height);
-  const FV sx = (__builtin_convertvector(px, FV) + u[0]) / w * 2.0f - 1.0f;
-  const FV sy = 1.0f - (__builtin_convertvector(py, FV) + u[1]) / h * 2.0f;
   const float tan_y = cam.tan_half_fov_y;
   const float tan_x = tan_y * w / h;
+  const float step = 2.0f * tan_y / h;
+  const FV x = madd(__builtin_convertvector(px, FV) + u[0], step, -tan_x);
+  const FV y = madd(-(__builtin_convertvector(py, FV) + u[1]), step, tan_y);
   auto bc = [](const Vec3f& v) { return V3{splat(v.x), splat(v.y), splat(v.z)}; };
-  const V3 d = normalize(bc(cam.forward) + bc(cam.right) * (sx * tan_x) + bc(cam.up) * (sy * tan_y));
+  const V3 d = fnormalize(madd(bc(cam.up), y, madd(bc(cam.right), x, bc(cam.forward))));
   FV ra[N], rb[N];
   ra[0] = splat(cam.position.x); ra[1] = splat(cam.position.y); ra[2] = splat(cam.position.z);
   ra[3] = d.x; ra[4] = d.y; ra[5] = d.z;

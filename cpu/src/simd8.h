@@ -4,9 +4,9 @@
 // compiled only under the matching `#pragma GCC target` (shade_avx2.cpp,
 // shade_avx512.cpp), used only on CPUs that have it. Every operation here is the
 // lane-wise twin of the scalar one the path step uses (IEEE +, -, *, /, sqrt,
-// compare-and-select; no FMA: -ffp-contract=off, which matters most under AVX-512, whose
-// target implies FMA), so a lane computes bit for bit what the scalar path step computes
-// for that path, whatever the width.
+// compare-and-select, and FMA -- madd -- exactly where the scalar code calls pb::fmadd;
+// never a contraction of the compiler's own: -ffp-contract=off), so a lane computes bit
+// for bit what the scalar path step computes for that path, whatever the width.
 #include <immintrin.h>
 
 #include <cstdint>
@@ -42,6 +42,21 @@ inline FV dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 
 inline FV splat(float x) { return FV{} + x; }
+inline FV splat(FV x) { return x; }
+
+// pb::fmadd (math.h) lane-wise: a * b + c, one rounding (a float operand is broadcast).
+// With math.h's fused vector operations, each the twin of the scalar one.
+#if PB_SIMD_LANES == 16
+inline FV madd_v(FV a, FV b, FV c) { return FV(_mm512_fmadd_ps(__m512(a), __m512(b), __m512(c))); }
+#else
+inline FV madd_v(FV a, FV b, FV c) { return FV(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c))); }
+#endif
+template <class A, class B, class C> inline FV madd(A a, B b, C c) { return madd_v(splat(a), splat(b), splat(c)); }
+inline V3 madd(V3 a, FV s, V3 c) { return {madd(a.x, s, c.x), madd(a.y, s, c.y), madd(a.z, s, c.z)}; }
+inline FV fdot(V3 a, V3 b) { return madd(a.x, b.x, madd(a.y, b.y, a.z * b.z)); }
+inline V3 fcross(V3 a, V3 b) {
+  return {madd(a.y, b.z, -(a.z * b.y)), madd(a.z, b.x, -(a.x * b.z)), madd(a.x, b.y, -(a.y * b.x))};
+}
 inline IV splat_i(int32_t x) { return IV{} + x; }
 inline IV bits(FV v) { return (IV)v; }  // a cast between vector types of one size keeps the bits
 inline FV from_bits(IV v) { return (FV)v; }
@@ -123,8 +138,9 @@ inline FV sqrt(FV a) { return FV(_mm256_sqrt_ps(__m256(a))); }
 inline FV abs(FV a) { return from_bits(bits(a) & 0x7fffffff); }
 inline FV copysign(FV mag, FV sign) { return from_bits((bits(mag) & 0x7fffffff) | (bits(sign) & int32_t(0x80000000u))); }
 
-// As math.h: a * (1 / length(a)).
+// As math.h: a * (1 / length(a)), unfused and fused.
 inline V3 normalize(V3 a) { return a * (1.0f / sqrt(dot(a, a))); }
+inline V3 fnormalize(V3 a) { return a * (1.0f / sqrt(fdot(a, a))); }
 
 // Frame<T>::from_normal (math.h), lane-wise, in the same order of operations.
 struct FrameV {
@@ -133,14 +149,14 @@ struct FrameV {
     const FV sign = copysign(splat(1.0f), n.z);
     const FV a = -1.0f / (sign + n.z);
     const FV b = n.x * n.y * a;
-    return {{1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
+    return {{madd(n.x * n.x, sign * a, 1.0f), sign * b, -sign * n.x}, {b, madd(n.y * n.y, a, sign), -n.y}, n};
   }
-  V3 to_world(V3 v) const { return s * v.x + t * v.y + n * v.z; }
+  V3 to_world(V3 v) const { return madd(s, v.x, madd(t, v.y, n * v.z)); }
 };
 
 // offset_ray_origin (ray_offset.h) lane-wise: the float-grid move along n.
 inline FV offset_coord(FV pc, FV nc, const RayOffset& off) {
-  const FV near_moved = pc + off.fixed_distance * nc;
+  const FV near_moved = madd(off.fixed_distance, nc, pc);
   const IV of = __builtin_convertvector(256.0f * nc, IV);  // truncation, as int32_t(float)
   const IV far_bits = bits(pc) + ((pc < 0.0f) ? -of : of);
   return select(abs(pc) < off.near_origin, near_moved, from_bits(far_bits));
@@ -149,11 +165,7 @@ inline V3 offset_ray_origin(V3 p, V3 n, const RayOffset& off) {
   return {offset_coord(p.x, n.x, off), offset_coord(p.y, n.y, off), offset_coord(p.z, n.z, off)};
 }
 
-// power_heuristic (sampling.h) lane-wise.
-inline FV power_heuristic(FV pdf_a, FV pdf_b) {
-  const FV a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-  return select(a > 0.0f, a / (a + b), splat(0.0f));
-}
+
 
 // 8-float records ("rows") to lanes and back: lane i of out[j] is rows[i][j].
 // Eight rows at a time: each 4x4 block is transposed inside a 128-bit half; the halves
@@ -269,8 +281,10 @@ inline void sincos_turns(FV u, FV& s, FV& c) {
   const IV upper = f > 0.5f;
   const FV g = select(upper, 1.0f - f, f);
   const FV y = g * 1.57079632679489662f, y2 = y * y;
-  const FV sp = y + y * y2 * (-1.66666667e-1f + y2 * (8.33333333e-3f + y2 * (-1.98412698e-4f + y2 * 2.75573192e-6f)));
-  const FV cp = 1.0f + y2 * (-0.5f + y2 * (4.16666667e-2f + y2 * (-1.38888889e-3f + y2 * (2.48015873e-5f + y2 * -2.75573192e-7f))));
+  const FV ps = madd(y2, madd(y2, madd(y2, 2.75573192e-6f, -1.98412698e-4f), 8.33333333e-3f), -1.66666667e-1f);
+  const FV sp = madd(y * y2, ps, y);
+  const FV pc = madd(y2, madd(y2, madd(y2, madd(y2, -2.75573192e-7f, 2.48015873e-5f), -1.38888889e-3f), 4.16666667e-2f), -0.5f);
+  const FV cp = madd(y2, pc, 1.0f);
   const FV sa = select(upper, cp, sp), ca = select(upper, sp, cp);
   const IV odd = (q & 1) != 0, half = (q & 2) != 0;
   const FV s1 = select(odd, ca, sa), c1 = select(odd, -sa, ca);

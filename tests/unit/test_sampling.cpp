@@ -462,3 +462,15 @@ TEST(LightPdf, IntegratesToOneWithSeveralEmitters) {
 
 }  // namespace
 }  // namespace pb
+
+// pb::fmadd (math.h) rounds once, on every path it may take (builtin, inline FMA behind
+// the CPU check, libm): a * b + c with a = 1 + 2^-12 keeps the 2^-24 term that rounding
+// a * a first would drop (a tie, to even), and likewise in double.
+TEST(Fmadd, RoundsOnce) {
+  const float a = 1.0f + 0x1p-12f;
+  EXPECT_EQ(pb::fmadd(a, a, -1.0f), 0x1p-11f + 0x1p-24f);
+  EXPECT_EQ(a * a - 1.0f, 0x1p-11f);  // the unfused value, for contrast
+  const double b = 1.0 + 0x1p-27;
+  EXPECT_EQ(pb::fmadd(b, b, -1.0), 0x1p-26 + 0x1p-54);
+  EXPECT_EQ(pb::fmadd(pb::Vec3f{a, 2.0f, a}, a, pb::Vec3f{-1.0f, 0.0f, 0.0f}).x, 0x1p-11f + 0x1p-24f);
+}

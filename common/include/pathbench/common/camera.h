@@ -23,12 +23,16 @@ template <class T> struct Ray {
 template <class T>
 PB_HD Ray<T> camera_ray(const Camera& c, uint32_t px, uint32_t py, uint32_t width, uint32_t height, float jx,
                         float jy) {
-  T sx = (T(px) + T(jx)) / T(width) * T(2) - T(1);   // -1 left .. +1 right
-  T sy = T(1) - (T(py) + T(jy)) / T(height) * T(2);  // +1 top .. -1 bottom
-  T tan_y = T(c.tan_half_fov_y);
-  T tan_x = tan_y * T(width) / T(height);
-  Vec3<T> d = Vec3<T>(c.forward) + Vec3<T>(c.right) * (sx * tan_x) + Vec3<T>(c.up) * (sy * tan_y);
-  return {Vec3<T>(c.position), normalize(d)};
+  // The image plane at distance 1: x from -tan_x (left) to +tan_x, y from +tan_y (top)
+  // to -tan_y; square pixels, each `step` wide. One division per ray where there were
+  // two (the CPU's batched twin, cpu/src/shade_x8.h's begin_paths, computes the same).
+  const T tan_y = T(c.tan_half_fov_y);
+  const T tan_x = tan_y * T(width) / T(height);
+  const T step = T(2) * tan_y / T(height);
+  const T x = fmadd(T(px) + T(jx), step, -tan_x);
+  const T y = fmadd(-(T(py) + T(jy)), step, tan_y);
+  const Vec3<T> d = fmadd(Vec3<T>(c.up), y, fmadd(Vec3<T>(c.right), x, Vec3<T>(c.forward)));
+  return {Vec3<T>(c.position), fnormalize(d)};
 }
 
 }  // namespace pb

@@ -95,8 +95,11 @@ PB_HD Vec3<T> emitted_radiance(const SceneView& s, const PathConfig& c, const Pa
   bool mis = c.sampling == Sampling::Nee && st.depth > 0;
   if constexpr ((Kinds & kDeltaKinds) != 0) mis = mis && st.bsdf_pdf > T(0);
   if (mis) {
-    T pdf_light = emitter_area_pdf<T>(s, Le) * h.t * h.t / cos_o;
-    w = power_heuristic(st.bsdf_pdf, pdf_light);
+    // power_heuristic(bsdf_pdf, pdf_light) with pdf_light = area_pdf t^2 / cos_o, both
+    // sides times cos_o^2: one division where there were two.
+    const T a = st.bsdf_pdf * cos_o, pa = emitter_area_pdf<T>(s, Le) * (h.t * h.t);
+    const T a2 = a * a;
+    w = a2 > T(0) ? a2 / fmadd(pa, pa, a2) : T(0);
   }
   return st.beta * Vec3<T>(Le) * w;
 }
@@ -106,7 +109,7 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
                          ShadowQuery<T>& shadow, bool& wants_shadow) {
   wants_shadow = false;
   const Material& m = s.material_of(h.prim);
-  const T cos_o = -dot(h.ng, st.ray.d);  // > 0: the ray hit the front side
+  const T cos_o = -fdot(h.ng, st.ray.d);  // > 0: the ray hit the front side
 
   // 1. Emission (one-sided), weighted against light sampling when that could have
   //    found this point too.
@@ -132,19 +135,23 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
     const Vec3<T> e1 = Vec3<T>(s.positions[tri.v[1]]) - v0;
     const Vec3<T> e2 = Vec3<T>(s.positions[tri.v[2]]) - v0;
     const Barycentrics<T> b = sample_uniform_triangle(T(u_pick), T(ub.v[3]));
-    const Vec3<T> y = v0 + e1 * b.b1 + e2 * b.b2;
-    const Vec3<T> nl = normalize(cross(e1, e2));
+    const Vec3<T> y = fmadd(e2, b.b2, fmadd(e1, b.b1, v0));
+    const Vec3<T> nl = fnormalize(fcross(e1, e2));
     Vec3<T> wi = y - h.p;
-    const T dist2 = dot(wi, wi);
-    wi = wi / std::sqrt(dist2);
-    const T cos_s = dot(n, wi);
-    const T cos_l = -dot(nl, wi);
+    const T dist2 = fdot(wi, wi);
+    wi = wi * (T(1) / std::sqrt(dist2));
+    const T cos_s = fdot(n, wi);
+    const T cos_l = -fdot(nl, wi);
     if (cos_s > T(0) && cos_l > T(0) && dist2 > T(0)) {
       const Vec3f Le = s.material_of(tri_id).emission;
-      const T pdf_light = emitter_area_pdf<T>(s, Le) * dist2 / cos_l;
       const BsdfEval<T> f = bsdf_eval<Kinds>(m, frame, st.ray.d, wi, cos_s);
-      const T w = power_heuristic(pdf_light, f.pdf);
-      shadow.contribution = st.beta * f.f * Vec3<T>(Le) * (cos_s * w / pdf_light);
+      // cos_s w / pdf_light, with w = power_heuristic(pdf_light, f.pdf) and pdf_light =
+      // pa / cos_l (pa = area_pdf dist2): cos_s cos_l pa / (pa^2 + (f.pdf cos_l)^2), one
+      // division where there were three.
+      const T pa = emitter_area_pdf<T>(s, Le) * dist2;
+      const T fc = f.pdf * cos_l;
+      const T k = cos_s * cos_l * pa / fmadd(pa, pa, fc * fc);
+      shadow.contribution = st.beta * f.f * Vec3<T>(Le) * k;
       const Vec3<T> target = offset_ray_origin(y, nl, s.offset);
       shadow.ray = {origin, target - origin};
       wants_shadow = true;
@@ -160,13 +167,13 @@ PB_HD PathEvent path_hit(const SceneView& s, const PathConfig& c, PathState<T>& 
   if (c.russian_roulette && vertex >= c.rr_start_depth) {
     const T q = pmin(max_component(st.beta), T(0.95));
     if (!(T(rng.draw(st.sample, vertex, kRngRoulette).v[0]) < q)) return PathEvent::Done;
-    st.beta = st.beta / q;
+    st.beta = st.beta * (T(1) / q);
   }
 
   // A refracted ray leaves from the other side of the surface.
   Vec3<T> next_origin = origin;
   if constexpr (has_kind<Kinds>(MaterialKind::Dielectric))
-    if (dot(bs.wi, n) < T(0)) next_origin = offset_ray_origin(h.p, -n, s.offset);
+    if (fdot(bs.wi, n) < T(0)) next_origin = offset_ray_origin(h.p, -n, s.offset);
   st.ray = {next_origin, bs.wi};
   st.bsdf_pdf = bs.pdf;
   st.depth = vertex;
@@ -205,7 +212,7 @@ PB_HD bool path_final_query(const SceneView& s, const PathConfig& c, const PathS
   }
   if (prim == ~0u) return false;
   const SurfaceHit<T> h = surface_hit(s, prim, st.ray);
-  const T cos_o = -dot(h.ng, st.ray.d);
+  const T cos_o = -fdot(h.ng, st.ray.d);
   const Vec3f Le = s.material_of(prim).emission;
   if (!(cos_o > T(0)) || is_zero(Le)) return false;
   q.contribution = emitted_radiance<Kinds>(s, c, st, h, Le, cos_o);

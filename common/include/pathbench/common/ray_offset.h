@@ -32,7 +32,7 @@ template <class T> PB_HD Vec3<T> offset_ray_origin(Vec3<T> p, Vec3<T> n, const R
     float nc = float(n[i]);
     float moved;
     if (std::fabs(pc) < off.near_origin) {
-      moved = pc + off.fixed_distance * nc;
+      moved = fmadd(off.fixed_distance, nc, pc);
     } else {
       int32_t of = int32_t(kIntScale * nc);
       int32_t bits;

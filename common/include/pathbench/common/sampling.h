@@ -22,8 +22,11 @@ template <class T> PB_HD void sincos_turns(T u, T& s, T& c) {
     const bool upper = f > 0.5f;
     const float g = upper ? 1.0f - f : f;  // [0, 0.5]
     const float y = g * 1.57079632679489662f, y2 = y * y;
-    const float sp = y + y * y2 * (-1.66666667e-1f + y2 * (8.33333333e-3f + y2 * (-1.98412698e-4f + y2 * 2.75573192e-6f)));
-    const float cp = 1.0f + y2 * (-0.5f + y2 * (4.16666667e-2f + y2 * (-1.38888889e-3f + y2 * (2.48015873e-5f + y2 * -2.75573192e-7f))));
+    // Horner in fused steps (fmadd), as the vector twin does.
+    const float ps = fmadd(y2, fmadd(y2, fmadd(y2, 2.75573192e-6f, -1.98412698e-4f), 8.33333333e-3f), -1.66666667e-1f);
+    const float sp = fmadd(y * y2, ps, y);
+    const float pc = fmadd(y2, fmadd(y2, fmadd(y2, fmadd(y2, -2.75573192e-7f, 2.48015873e-5f), -1.38888889e-3f), 4.16666667e-2f), -0.5f);
+    const float cp = fmadd(y2, pc, 1.0f);
     const float sa = upper ? cp : sp, ca = upper ? sp : cp;  // of the angle f pi / 2
     const float s1 = (q & 1) ? ca : sa, c1 = (q & 1) ? -sa : ca;
     s = (q & 2) ? -s1 : s1;
@@ -38,7 +41,7 @@ template <class T> PB_HD void sincos_turns(T u, T& s, T& c) {
 // Uniform over the hemisphere around +z: the paper's sampler. pdf = 1 / (2 pi).
 template <class T> PB_HD Vec3<T> sample_uniform_hemisphere(T u0, T u1) {
   T z = u0;
-  T r = std::sqrt(pmax(T(0), T(1) - z * z));
+  T r = std::sqrt(pmax(T(0), fmadd(-z, z, T(1))));
   T sin_phi, cos_phi;
   sincos_turns(u1, sin_phi, cos_phi);
   return {r * cos_phi, r * sin_phi, z};
@@ -65,8 +68,8 @@ template <class T> PB_HD Barycentrics<T> sample_uniform_triangle(T u0, T u1) {
 
 // Power heuristic with beta = 2 (Veach 1997) for two strategies of one sample each.
 template <class T> PB_HD T power_heuristic(T pdf_a, T pdf_b) {
-  T a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-  return a > T(0) ? a / (a + b) : T(0);
+  T a = pdf_a * pdf_a;
+  return a > T(0) ? a / fmadd(pdf_b, pdf_b, a) : T(0);
 }
 
 }  // namespace pb

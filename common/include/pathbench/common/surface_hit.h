@@ -24,20 +24,21 @@ template <class T> PB_HD SurfaceHit<T> surface_hit(const SceneView& s, uint32_t 
   const Vec3<T> e1 = Vec3<T>(s.positions[tri.v[1]]) - v0;
   const Vec3<T> e2 = Vec3<T>(s.positions[tri.v[2]]) - v0;
   // Moeller-Trumbore without rejection: the intersector already accepted this hit.
-  Vec3<T> pv = cross(ray.d, e2);
-  T inv_det = T(1) / dot(e1, pv);
+  // (Fused: fdot / fcross, as the rest of the path step.)
+  Vec3<T> pv = fcross(ray.d, e2);
+  T inv_det = T(1) / fdot(e1, pv);
   Vec3<T> tv = ray.o - v0;
-  T b1 = dot(tv, pv) * inv_det;
-  Vec3<T> qv = cross(tv, e1);
-  T b2 = dot(ray.d, qv) * inv_det;
-  T t = dot(e2, qv) * inv_det;
+  T b1 = fdot(tv, pv) * inv_det;
+  Vec3<T> qv = fcross(tv, e1);
+  T b2 = fdot(ray.d, qv) * inv_det;
+  T t = fdot(e2, qv) * inv_det;
   // Clamp into the triangle: a hit found exactly on an edge may land a rounding
   // error outside it.
   b1 = pmin(pmax(b1, T(0)), T(1));
   b2 = pmin(pmax(b2, T(0)), T(1) - b1);
   SurfaceHit<T> h;
-  h.p = v0 + e1 * b1 + e2 * b2;
-  h.ng = normalize(cross(e1, e2));
+  h.p = fmadd(e2, b2, fmadd(e1, b1, v0));
+  h.ng = fnormalize(fcross(e1, e2));
   h.t = t;
   h.prim = prim;
   return h;

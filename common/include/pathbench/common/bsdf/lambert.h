@@ -29,7 +29,9 @@ PB_HD bool lambert_sample(Vec3f albedo, Sampling sampling, const Frame<T>& frame
     pdf = cosine_hemisphere_pdf(local.z);
   }
   if (!(pdf > T(0)) || !(local.z > T(0))) return false;
-  bs.weight = lambert_f<T>(albedo) * (local.z / pdf);
+  // f cos / pdf in closed form: (albedo / pi) cos / (1 / 2 pi) = albedo 2 cos for the
+  // uniform hemisphere, (albedo / pi) cos / (cos / pi) = albedo for the cosine one.
+  bs.weight = sampling == Sampling::Uniform ? Vec3<T>(albedo) * (T(2) * local.z) : Vec3<T>(albedo);
   bs.wi = frame.to_world(local);
   bs.pdf = pdf;
   return true;

@@ -18,14 +18,14 @@ namespace pb {
 
 template <class T> PB_HD T ggx_d(T alpha, Vec3<T> m) {
   const T a2 = alpha * alpha;
-  const T k = (m.x * m.x + m.y * m.y) / a2 + m.z * m.z;
+  const T k = fmadd(m.z, m.z, fmadd(m.x, m.x, m.y * m.y) / a2);
   const T d = T(1) / (kPi<T> * a2 * k * k);
   return d * m.z > T(1e-20) ? d : T(0);
 }
 
 template <class T> PB_HD T ggx_g1(T alpha, Vec3<T> v, Vec3<T> m) {
-  if (dot(v, m) * v.z <= T(0)) return T(0);
-  const T xy2 = alpha * alpha * (v.x * v.x + v.y * v.y);
+  if (fdot(v, m) * v.z <= T(0)) return T(0);
+  const T xy2 = alpha * alpha * fmadd(v.x, v.x, v.y * v.y);
   if (xy2 == T(0)) return T(1);
   return T(2) / (T(1) + std::sqrt(T(1) + xy2 / (v.z * v.z)));
 }
@@ -33,10 +33,10 @@ template <class T> PB_HD T ggx_g1(T alpha, Vec3<T> v, Vec3<T> m) {
 // A normal of the GGX distribution seen from wo (Heitz 2018, "Sampling the GGX
 // Distribution of Visible Normals"): density D_wo(m) = G1(wo, m) max(0, wo.m) D(m) / wo.z.
 template <class T> PB_HD Vec3<T> ggx_sample_visible_normal(T alpha, Vec3<T> wo, T u0, T u1) {
-  const Vec3<T> vh = normalize(Vec3<T>{alpha * wo.x, alpha * wo.y, wo.z});
-  const T len2 = vh.x * vh.x + vh.y * vh.y;
+  const Vec3<T> vh = fnormalize(Vec3<T>{alpha * wo.x, alpha * wo.y, wo.z});
+  const T len2 = fmadd(vh.x, vh.x, vh.y * vh.y);
   const Vec3<T> t1 = len2 > T(0) ? Vec3<T>{-vh.y, vh.x, T(0)} * (T(1) / std::sqrt(len2)) : Vec3<T>{T(1), T(0), T(0)};
-  const Vec3<T> t2 = cross(vh, t1);
+  const Vec3<T> t2 = fcross(vh, t1);
   const T r = std::sqrt(u0);
   // sincos_turns, not std::sin/std::cos of 2 pi u1: the CPU's libm and CUDA's sinf/cosf
   // round differently, and the GPU's samples must be the CPU's bit for bit.
@@ -44,14 +44,14 @@ template <class T> PB_HD Vec3<T> ggx_sample_visible_normal(T alpha, Vec3<T> wo, 
   sincos_turns(u1, sin_phi, cos_phi);
   const T p1 = r * cos_phi;
   const T s = T(0.5) * (T(1) + vh.z);
-  const T p2 = (T(1) - s) * std::sqrt(pmax(T(0), T(1) - p1 * p1)) + s * (r * sin_phi);
-  const Vec3<T> nh = t1 * p1 + t2 * p2 + vh * std::sqrt(pmax(T(0), T(1) - p1 * p1 - p2 * p2));
-  return normalize(Vec3<T>{alpha * nh.x, alpha * nh.y, pmax(T(0), nh.z)});
+  const T p2 = fmadd(T(1) - s, std::sqrt(pmax(T(0), fmadd(-p1, p1, T(1)))), s * (r * sin_phi));
+  const Vec3<T> nh = fmadd(t2, p2, fmadd(t1, p1, vh * std::sqrt(pmax(T(0), fmadd(-p2, p2, fmadd(-p1, p1, T(1)))))));
+  return fnormalize(Vec3<T>{alpha * nh.x, alpha * nh.y, pmax(T(0), nh.z)});
 }
 
 template <class T> PB_HD BsdfEval<T> roughconductor_eval(Vec3f albedo, T alpha, Vec3<T> wo, Vec3<T> wi) {
   if (!(wo.z > T(0)) || !(wi.z > T(0))) return {{T(0), T(0), T(0)}, T(0)};
-  const Vec3<T> m = normalize(wo + wi);
+  const Vec3<T> m = fnormalize(wo + wi);
   const T d = ggx_d(alpha, m);
   const T g1o = ggx_g1(alpha, wo, m);
   const T f = d * g1o * ggx_g1(alpha, wi, m) / (T(4) * wo.z * wi.z);
@@ -64,7 +64,7 @@ PB_HD bool roughconductor_sample(Vec3f albedo, T alpha, const Frame<T>& frame, V
                                  BsdfSample<T>& bs) {
   if (!(wo.z > T(0))) return false;
   const Vec3<T> m = ggx_sample_visible_normal(alpha, wo, u0, u1);
-  const Vec3<T> wi = m * (T(2) * dot(wo, m)) - wo;
+  const Vec3<T> wi = fmadd(m, T(2) * fdot(wo, m), -wo);
   if (!(wi.z > T(0))) return false;
   const T d = ggx_d(alpha, m);
   bs.pdf = d * ggx_g1(alpha, wo, m) / (T(4) * wo.z);

@@ -25,9 +25,9 @@ template <class T> struct BsdfEval {
 };
 
 // v in the frame's local coordinates (z along the normal).
-template <class T> PB_HD Vec3<T> to_local(const Frame<T>& f, Vec3<T> v) { return {dot(v, f.s), dot(v, f.t), dot(v, f.n)}; }
+template <class T> PB_HD Vec3<T> to_local(const Frame<T>& f, Vec3<T> v) { return {fdot(v, f.s), fdot(v, f.t), fdot(v, f.n)}; }
 
 // Mirror reflection of the incoming ray direction d about n (n facing -d).
-template <class T> PB_HD Vec3<T> reflect(Vec3<T> d, Vec3<T> n) { return d - n * (T(2) * dot(d, n)); }
+template <class T> PB_HD Vec3<T> reflect(Vec3<T> d, Vec3<T> n) { return fmadd(n, T(-2) * fdot(d, n), d); }
 
 }  // namespace pb
