@@ -14,13 +14,10 @@
 
 #include "pathbench/common/film.h"
 
-namespace pb::gpu {
-class DeviceFilm;
-}
-
 namespace pb::run {
 
 class World;
+class DeviceFilm;  // tracer.h: a GPU rank's film on its device
 
 struct GpuReduction {
   bool nccl = false;   // the GPU ranks' films are reduced through NCCL (every rank knows)
@@ -40,13 +37,13 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index);
 // reduction of the (cleared) device films and one overflow check, so that the frame's
 // own reduction finds NCCL's connections made (NCCL makes them at a communicator's first
 // collective: 0.16 s for 2 H100s, 0.34 s for 4) and the check's kernel loaded.
-void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film);
+void warm_gpu_reduction(const GpuReduction& r, DeviceFilm* film);
 
 // Collective over every rank, after the frame (r.nccl only): GPU ranks pass their device
 // film, others null. True (on every rank) when the GPUs' films were added onto r.root's
 // device film; false when the overflow bound refused (then nothing was added). `seconds`
 // gets the time of the bound check and of NCCL's reduction on this rank.
-bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+bool reduce_gpu_films(World& w, const GpuReduction& r, DeviceFilm* film, double& bound_seconds,
                       double& nccl_seconds);
 
 // While it lives, `film`'s host arrays are page-locked for the device's copies (the one

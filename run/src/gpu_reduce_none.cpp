@@ -6,8 +6,8 @@ namespace pb::run {
 GpuReduction prepare_gpu_reduction(World&, bool, int) {
   return {false, -1, "mpi", "this build has no NCCL (configure with -DPATHBENCH_NCCL=ON and NCCL installed)", ""};
 }
-void warm_gpu_reduction(const GpuReduction&, gpu::DeviceFilm*) {}
-bool reduce_gpu_films(World&, const GpuReduction&, gpu::DeviceFilm*, double&, double&) { return false; }
+void warm_gpu_reduction(const GpuReduction&, DeviceFilm*) {}
+bool reduce_gpu_films(World&, const GpuReduction&, DeviceFilm*, double&, double&) { return false; }
 PinnedFilm::PinnedFilm(Film&, bool) {}
 PinnedFilm::~PinnedFilm() = default;
 

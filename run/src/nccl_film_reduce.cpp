@@ -13,8 +13,8 @@
 
 #include "gpu_reduce.h"
 #include "mpi_detail.h"
-#include "pathbench/gpu/render.h"
 #include "pathbench/run/ranks.h"
+#include "pathbench/run/tracer.h"
 #include "pathbench/run/world.h"
 
 namespace pb::run {
@@ -105,8 +105,8 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index) {
 
 namespace {
 // Adds the GPU ranks' device films onto the GPU communicator's rank 0, in place there.
-void nccl_reduce(gpu::DeviceFilm& film) {
-  const gpu::DeviceFilm::Arrays a = film.arrays();
+void nccl_reduce(DeviceFilm& film) {
+  const DeviceFilm::Arrays a = film.arrays();
   nccl_check(ncclGroupStart(), "ncclGroupStart");
   nccl_check(ncclReduce(a.sums, a.sums, a.pixels * 3, ncclInt64, ncclSum, 0, current->nccl, current->stream),
              "ncclReduce (sums)");
@@ -120,13 +120,13 @@ void nccl_reduce(gpu::DeviceFilm& film) {
 }
 }  // namespace
 
-void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film) {
+void warm_gpu_reduction(const GpuReduction& r, DeviceFilm* film) {
   if (!r.nccl || !current || !film) return;
   (void)film->max_abs_sum();
   nccl_reduce(*film);  // zeros onto zeros: the root's film stays cleared
 }
 
-bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+bool reduce_gpu_films(World& w, const GpuReduction& r, DeviceFilm* film, double& bound_seconds,
                       double& nccl_seconds) {
   using Clock = std::chrono::steady_clock;
   bound_seconds = nccl_seconds = 0;
