@@ -21,7 +21,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/image_io.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 #include "pathbench/run/run_context.h"
 

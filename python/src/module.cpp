@@ -17,7 +17,7 @@
 #include "arguments.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/common/scene_warnings.h"
 #include "pathbench/run/run.h"
 #include "ray_cast.h"

@@ -16,7 +16,7 @@
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 namespace {

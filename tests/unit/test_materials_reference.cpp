@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <string>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "reference_test.h"
 
 namespace pb {

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 

@@ -11,13 +11,13 @@
 #include <unordered_map>
 
 #include "pathbench/common/scene_warnings.h"
-#include "pathbench/common/data_dir.h"
+#include "pathbench/scene_io/data_dir.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/json_input.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/common/scene_library.h"
-#include "scene_io/scene_io.h"
+#include "pathbench/scene_io/scene_library.h"
+#include "readers/readers.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {
@@ -68,7 +68,6 @@ class JsonSceneReader {
       for (size_t i = 0; i < groups.size(); ++i) read_triangles(s, groups[i], fmt::format("triangles[{}]", i));
     }
     if (s.triangles.empty()) fail("", "the scene has no triangles (give \"meshes\" or \"triangles\")");
-    s.finalize();
     return s;
   }
 
@@ -369,12 +368,3 @@ Scene parse_scene_json(const std::string& path, const std::string& text, const F
 }
 
 }  // namespace pb::scene_io
-
-namespace pb {
-
-Scene load_scene_json(const std::string& path, bool strict) {
-  return scene_io::parse_scene_json(path, read_input_file(path, "scene file (JSON)", limits::kMaxSceneJsonBytes),
-                                    scene_io::disk_reader(), scene_io::Losses(strict));
-}
-
-}  // namespace pb

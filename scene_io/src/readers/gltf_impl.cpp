@@ -3,4 +3,4 @@
 // <fstream>: its writer uses std::ofstream even without a file system (TINYGLTF_NO_FS).
 #include <fstream>
 #define TINYGLTF_IMPLEMENTATION
-#include "scene_io/gltf_config.h"
+#include "readers/gltf_config.h"

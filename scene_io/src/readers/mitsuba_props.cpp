@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "pathbench/common/errors.h"
-#include "scene_io/mitsuba.h"
+#include "readers/mitsuba.h"
 
 namespace pb::scene_io::mitsuba {
 

@@ -1,7 +1,7 @@
 // The 2015 paper's Cornell box, exactly as ../shared/paper-scene.md gives it.
 #include <cmath>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 

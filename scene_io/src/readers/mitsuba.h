@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "pathbench/common/affine.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace pb::scene_io::mitsuba {
 

@@ -13,9 +13,9 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
-#include "scene_io/gltf_config.h"
-#include "scene_io/gltf_input.h"
-#include "scene_io/scene_io.h"
+#include "readers/gltf_config.h"
+#include "readers/gltf_input.h"
+#include "readers/readers.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {
@@ -81,7 +81,6 @@ class GltfReader {
     if (s.triangles.empty()) fail("the scene has no triangle meshes");
     frame_bare_mesh(s, path_, !have_camera_, "emissiveFactor");
     if (have_camera_) s.camera = camera_;
-    s.finalize();
     return s;
   }
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 

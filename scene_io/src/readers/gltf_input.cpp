@@ -1,5 +1,5 @@
 // The glTF reader's checks on the bytes before tinygltf parses them (gltf_input.h).
-#include "scene_io/gltf_input.h"
+#include "readers/gltf_input.h"
 
 #include <fmt/core.h>
 

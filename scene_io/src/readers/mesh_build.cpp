@@ -12,7 +12,7 @@
 #include "pathbench/common/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {
@@ -199,7 +199,6 @@ Scene bare_mesh_scene(const std::string& path, const MeshData& mesh, const char*
   const uint32_t grey = scenes::add_material(s, "default", {0.5f, 0.5f, 0.5f});
   append_mesh(s, mesh, Affine(), {grey});
   frame_bare_mesh(s, path, true, emitter_hint);
-  s.finalize();
   return s;
 }
 

@@ -23,8 +23,8 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/common/scene_library.h"
-#include "scene_io/scene_io.h"
+#include "pathbench/scene_io/scene_library.h"
+#include "readers/readers.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {
@@ -346,15 +346,7 @@ Scene parse_scene_obj(const std::string& path, const std::string& text, const Fi
     scenes::add_triangle(s, t.v[0], t.v[1], t.v[2], mat);
   }
   frame_bare_mesh(s, path, true, "MTL Ke");
-  s.finalize();
   return s;
 }
 
 }  // namespace pb::scene_io
-
-namespace pb {
-Scene load_scene_obj(const std::string& path, bool strict) {
-  return scene_io::parse_scene_obj(path, read_input_file(path, "mesh file (OBJ)", limits::kMaxMeshBytes),
-                                   scene_io::disk_reader(), scene_io::Losses(strict));
-}
-}  // namespace pb

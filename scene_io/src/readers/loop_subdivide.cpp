@@ -11,7 +11,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace pb::scene_io {
 

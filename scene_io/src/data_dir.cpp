@@ -1,4 +1,4 @@
-#include "pathbench/common/data_dir.h"
+#include "pathbench/scene_io/data_dir.h"
 
 #include <fmt/core.h>
 

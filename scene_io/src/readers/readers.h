@@ -1,5 +1,5 @@
 #pragma once
-// Private to pathbench_common (and the fuzz targets): the scene-file readers working
+// Private to pathbench_scene_io (and the fuzz targets and reader tests): the scene-file readers working
 // on text already read, with every further file (an OBJ's MTL libraries, a JSON
 // scene's meshes) read through a FileReader. Production reads files with
 // read_input_file; the fuzzers hand in fixed or fuzzed text instead of files.
@@ -38,13 +38,19 @@ class Losses {
   mutable std::set<std::string> said_;
 };
 
-// `text` is the file at `path` (for messages and to resolve relative names).
+// The one entry point (scene_file.cpp): `text` is the file at `path` (for messages and to
+// resolve relative names); the reader is picked by the path's extension (.json, .obj, .ply,
+// .off, .gltf, .glb, .xml; InputError for any other) and the scene it returns is finalized
+// (Scene::finalize), here and nowhere else.
+Scene parse_scene(const std::string& path, const std::string& text, const FileReader& read,
+                  const Losses& losses = Losses());
+
+// The readers, one per format, as parse_scene calls them: the scene they return is not
+// finalized yet.
 Scene parse_scene_json(const std::string& path, const std::string& text, const FileReader& read,
                        const Losses& losses = Losses());
 Scene parse_scene_obj(const std::string& path, const std::string& text, const FileReader& read,
                       const Losses& losses = Losses());
-Scene parse_scene_ply(const std::string& path, const std::string& text, const Losses& losses = Losses());
-Scene parse_scene_off(const std::string& path, const std::string& text, const Losses& losses = Losses());
 // .gltf (JSON; its buffers read through `read`) or .glb (binary), by `binary`.
 Scene parse_scene_gltf(const std::string& path, const std::string& text, bool binary, const FileReader& read,
                        const Losses& losses = Losses());

@@ -43,10 +43,8 @@ Scene make_paper_cornell_ico(int level);
 // 0.5): about `triangles` in all (the sphere takes the remainder; at least the box's 14).
 Scene make_scaling(uint64_t triangles);
 
-// Scene files (common/src/scene_io/), each by its format.
-Scene load_scene_json(const std::string& path, bool strict = false);
-Scene load_scene_obj(const std::string& path, bool strict = false);
-// By the file's extension (any case); InputError for one pathbench does not read.
+// A scene file (scene_io/src/readers/, one reader per format), by the file's extension (any
+// case), finalized; InputError for one pathbench does not read.
 Scene load_scene_file(const std::string& path, bool strict = false);
 // True when `name` ends in an extension of a scene file pathbench reads.
 bool is_scene_file_name(const std::string& name);

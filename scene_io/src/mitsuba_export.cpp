@@ -1,4 +1,4 @@
-#include "mitsuba_export.h"
+#include "pathbench/scene_io/mitsuba_export.h"
 
 #include <fmt/core.h>
 
@@ -9,14 +9,14 @@
 
 #include "pathbench/common/output_file.h"
 
-namespace pb::app {
+namespace pb {
 
 namespace {
 
 std::string rgb(Vec3f c) { return fmt::format("{:.9g}, {:.9g}, {:.9g}", c.x, c.y, c.z); }
 
-// The Mitsuba plugin pathbench's BSDF of each kind is defined as (tools/mitsuba_scene.py's
-// material_bsdf, the same mapping).
+// The Mitsuba plugin pathbench's BSDF of each kind is defined as: the one definition of this
+// mapping (the XML reader, readers/mitsuba_bsdf.cpp, maps these plugins back).
 std::string bsdf(const Material& m) {
   const std::string c = rgb(m.albedo);
   switch (m.kind) {
@@ -100,4 +100,4 @@ std::string write_mitsuba_scene(const Scene& s, const RenderSettings& settings, 
   return path;
 }
 
-}  // namespace pb::app
+}  // namespace pb

@@ -1,13 +1,13 @@
 // Mitsuba 3 BSDFs -> pathbench materials: diffuse, twosided, conductor (material
 // "none": a mirror), roughconductor (GGX), dielectric. Each as Mitsuba defines it
-// (tools/mitsuba_scene.py maps the other way); anything else named as not modelled.
+// (../mitsuba_export.cpp maps the other way); anything else named as not modelled.
 // Also the built-in shapes (rectangle, cube, sphere) as meshes.
 #include <fmt/core.h>
 
 #include <cmath>
 
 #include "pathbench/common/errors.h"
-#include "scene_io/mitsuba.h"
+#include "readers/mitsuba.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io::mitsuba {

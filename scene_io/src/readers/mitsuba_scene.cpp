@@ -11,7 +11,7 @@
 
 #include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
-#include "scene_io/mitsuba.h"
+#include "readers/mitsuba.h"
 #include "scenes/builder.h"
 
 namespace pb::scene_io {
@@ -58,7 +58,6 @@ class MitsubaReader {
                                 "triangles only)", doc_.path, spheres_, spheres_ == 1 ? "" : "s", mitsuba::kSphereTriangles));
     if (!have_sensor) doc_.fail(root, "the scene has no <sensor type=\"perspective\"> (pathbench needs its camera)");
     if (s.triangles.empty()) doc_.fail(root, "the scene has no shapes with triangles");
-    s.finalize();
     return s;
   }
 

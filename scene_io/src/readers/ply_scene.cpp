@@ -13,7 +13,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace pb::scene_io {
 
@@ -292,10 +292,6 @@ class PlyReader {
 
 MeshData read_ply(const std::string& path, const std::string& text, const Losses& losses) {
   return PlyReader(path, text).read(losses);
-}
-
-Scene parse_scene_ply(const std::string& path, const std::string& text, const Losses& losses) {
-  return bare_mesh_scene(path, read_ply(path, text, losses), "a PLY mesh has no materials");
 }
 
 }  // namespace pb::scene_io

@@ -14,7 +14,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace pb::scene_io {
 
@@ -156,10 +156,6 @@ class OffReader {
 
 MeshData read_off(const std::string& path, const std::string& text, const Losses& losses) {
   return OffReader(path, text).read(losses);
-}
-
-Scene parse_scene_off(const std::string& path, const std::string& text, const Losses& losses) {
-  return bare_mesh_scene(path, read_off(path, text, losses), "an OFF mesh has no materials");
 }
 
 }  // namespace pb::scene_io

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "builder.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 

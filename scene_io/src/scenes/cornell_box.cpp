@@ -18,7 +18,7 @@
 
 #include "builder.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 

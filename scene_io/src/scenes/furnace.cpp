@@ -1,7 +1,7 @@
 // White furnace: a closed cube whose every wall reflects `albedo` and emits
 // `emission`. Every path sees the same radiance, known in closed form:
 // Le (1 + a + ... + a^k) after k bounces, Le / (1 - a) unbounded.
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 
