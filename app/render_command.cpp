@@ -11,7 +11,7 @@
 #include "cli_checks.h"
 #include "pathbench/common/display_text.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/common/report.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/ranks_render.h"

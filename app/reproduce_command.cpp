@@ -9,10 +9,10 @@
 
 #include "cli_checks.h"
 #include "output_dirs.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/fingerprint.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/ranks_render.h"
 #include "pathbench/run/run.h"

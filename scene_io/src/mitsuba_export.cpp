@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 
 namespace pb {
 

@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/scene_io/scene_library.h"

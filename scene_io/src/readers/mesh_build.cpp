@@ -9,7 +9,7 @@
 
 #include "pathbench/common/scene_warnings.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
 #include "readers/readers.h"

@@ -12,7 +12,7 @@
 #include <cstring>
 
 #include "output_signals.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 
 namespace pb {
 namespace detail {

@@ -1,4 +1,4 @@
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 
 #include <fcntl.h>
 #include <limits.h>

@@ -1,4 +1,4 @@
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 
 #include <fmt/core.h>
 
@@ -15,7 +15,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 
 #if PATHBENCH_HAVE_OIIO
 #include <OpenImageIO/filesystem.h>
