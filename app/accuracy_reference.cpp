@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/film.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/common/report.h"
 #include "pathbench/run/ranks_render.h"

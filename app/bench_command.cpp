@@ -14,8 +14,8 @@
 
 #include "cli_checks.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/image_io.h"
+#include "pathbench/output/output_file.h"
 #include "pathbench/run/world.h"
 
 namespace pb::app {

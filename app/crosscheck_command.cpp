@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "cli_checks.h"
-#include "mitsuba_export.h"
+#include "pathbench/scene_io/mitsuba_export.h"
 #include "pathbench/common/display_text.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
-#include "pathbench/common/output_file.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/output/image_io.h"
+#include "pathbench/output/output_file.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 #include "python_tools.h"
 

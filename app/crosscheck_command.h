@@ -1,8 +1,8 @@
 #pragma once
 // `pathbench crosscheck SCENE`: renders a scene with pathbench (CPU, and GPU where
-// present) and with Mitsuba 3 (the scene exported by mitsuba_export.h, or a Mitsuba XML
-// scene read by Mitsuba itself), and judges each pathbench image against Mitsuba's with
-// the per-pixel z-test the test suite uses (tools/crosscheck.py): a verdict and
+// present) and with Mitsuba 3 (the scene exported by pathbench/scene_io/mitsuba_export.h,
+// or a Mitsuba XML scene read by Mitsuba itself), and judges each pathbench image against
+// Mitsuba's with the per-pixel z-test the test suite uses (tools/crosscheck.py): a verdict and
 // difference images. Exit status: 0 same up to noise, 1 different, 2 bad input (then
 // nothing this run wrote is left in --out-dir), 3 an internal failure.
 #include <CLI/CLI.hpp>

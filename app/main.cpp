@@ -14,7 +14,7 @@
 #include "history_command.h"
 #include "pathbench/common/display_text.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 #include "pathbench/run/world.h"
 #include "render_command.h"
 #include "reproduce_command.h"

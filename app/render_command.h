@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "pathbench/common/output_file.h"  // write_text_file
+#include "pathbench/output/output_file.h"  // write_text_file
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/common/scene.h"

@@ -3,7 +3,7 @@
 #include <fmt/core.h>
 
 #include "pathbench/common/fingerprint.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/common/report.h"
 
 #ifndef PATHBENCH_VERSION

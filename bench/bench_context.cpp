@@ -14,7 +14,7 @@
 
 #include "pathbench/analysis/bench_compare.h"
 #include "pathbench/common/fingerprint.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 #include "pathbench/common/report.h"
 #include "pathbench/cpu/isa.h"
 #include "pathbench/run/run_context.h"

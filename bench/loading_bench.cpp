@@ -11,7 +11,7 @@
 #include <string>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/common/scene_warnings.h"
 
 namespace pb::bench {

@@ -14,8 +14,8 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/bvh/bvh_layout.h"
-#include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
+#include "pathbench/run/tracer.h"
 #include "raycast_bench.h"
 #include "scene_cache.h"
 
@@ -24,16 +24,16 @@ namespace pb::bench {
 namespace {
 
 struct GpuPrepared {
-  std::unique_ptr<gpu::GpuScene> scene;
-  std::vector<gpu::TraceQuery> coherent, incoherent;
+  std::unique_ptr<run::PreparedScene> scene;  // the GPU's BVH, uploaded (run/tracer.h)
+  std::vector<run::RayQuery> coherent, incoherent;
 };
 
 // The stored rays, repeated until one launch holds at least kMinRays: 65,536 camera rays
 // alone leave an H100 mostly idle and measure launch latency, not traversal.
 constexpr size_t kMinRays = size_t(1) << 22;
 
-std::vector<gpu::TraceQuery> to_queries(const RaySet& s, bool any_hit) {
-  std::vector<gpu::TraceQuery> q;
+std::vector<run::RayQuery> to_queries(const RaySet& s, bool any_hit) {
+  std::vector<run::RayQuery> q;
   if (s.size() == 0) return q;
   const size_t copies = (kMinRays + s.size() - 1) / s.size();
   q.reserve(copies * s.size());
@@ -48,7 +48,7 @@ constexpr size_t kBruteBenchMaxTriangles = 4096;
 
 // `layout` Auto: the options from the environment (what renders use).
 void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit, bool coherent,
-                     gpu::GpuBvhLayout layout) {
+                     bvh::GpuBvhLayout layout) {
   std::string why;
   if (!run::gpu_available(&why)) {
     state.SkipWithError(("no GPU: " + why).c_str());
@@ -56,27 +56,27 @@ void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit
   }
   std::shared_ptr<GpuPrepared> prep;
   const std::string kind = fmt::format("gpu-raycast:{}x{}:{}:{}", c.width, c.height, any_hit ? "any" : "closest",
-                                       gpu::to_string(layout));
+                                       bvh::to_string(layout));
   try {
     prep = std::static_pointer_cast<GpuPrepared>(cached_extra(c.scene, kind));
     if (!prep) {
       std::shared_ptr<const Scene> scene = cached_scene(c.scene);
-      if (layout == gpu::GpuBvhLayout::Brute && scene->triangles.size() > kBruteBenchMaxTriangles) {
+      if (layout == bvh::GpuBvhLayout::Brute && scene->triangles.size() > kBruteBenchMaxTriangles) {
         state.SkipWithError(fmt::format("brute force on {} triangles: over {}", scene->triangles.size(),
                                         kBruteBenchMaxTriangles).c_str());
         return;
       }
-      if (layout == gpu::GpuBvhLayout::Leaves && scene->triangles.size() > gpu::kLeavesMaxTriangles) {
+      if (layout == bvh::GpuBvhLayout::Leaves && scene->triangles.size() > bvh::kLeavesMaxTriangles) {
         state.SkipWithError(fmt::format("leaves on {} triangles: over {}", scene->triangles.size(),
-                                        gpu::kLeavesMaxTriangles).c_str());
+                                        bvh::kLeavesMaxTriangles).c_str());
         return;
       }
       const RaySets rays = make_ray_sets(*scene, *cpu::make_embree_scene(*scene, RenderSettings{}.watertight), c.width,
                                          c.height);
       prep = std::make_shared<GpuPrepared>();
-      gpu::GpuBvhOptions options = gpu::GpuBvhOptions::from_env();
-      if (layout != gpu::GpuBvhLayout::Auto) options.layout = layout;
-      prep->scene = std::make_unique<gpu::GpuScene>(*scene, options);
+      bvh::GpuBvhOptions options = bvh::GpuBvhOptions::from_env();
+      if (layout != bvh::GpuBvhLayout::Auto) options.layout = layout;
+      prep->scene = run::gpu_tracer().prepare_bvh(*scene, options);
       prep->coherent = to_queries(rays.coherent, any_hit);
       prep->incoherent = to_queries(rays.incoherent, any_hit);
       store_extra(c.scene, kind, prep);
@@ -85,14 +85,14 @@ void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit
     state.SkipWithError(fmt::format("scene not available: {}", e.what()).c_str());
     return;
   }
-  const std::vector<gpu::TraceQuery>& rays = coherent ? prep->coherent : prep->incoherent;
+  const std::vector<run::RayQuery>& rays = coherent ? prep->coherent : prep->incoherent;
   if (rays.empty()) {
     state.SkipWithError("no rays: every camera ray missed the scene");
     return;
   }
   for (auto _ : state) {
     try {
-      state.SetIterationTime(gpu::time_trace_on_device(*prep->scene, rays, any_hit, 1).front());
+      state.SetIterationTime(prep->scene->time_rays(rays, any_hit, 1).front());
     } catch (const std::exception& e) {
       state.SkipWithError(e.what());
       break;
@@ -106,15 +106,15 @@ void run_gpu_raycast(benchmark::State& state, const RaycastCase& c, bool any_hit
 
 }  // namespace
 
-void register_gpu_raycast_benchmarks(const RaycastCase& c) { register_gpu_raycast_benchmarks(c, {gpu::GpuBvhLayout::Auto}); }
+void register_gpu_raycast_benchmarks(const RaycastCase& c) { register_gpu_raycast_benchmarks(c, {bvh::GpuBvhLayout::Auto}); }
 
-void register_gpu_raycast_benchmarks(const RaycastCase& c, const std::vector<gpu::GpuBvhLayout>& layouts) {
-  for (gpu::GpuBvhLayout layout : layouts)
+void register_gpu_raycast_benchmarks(const RaycastCase& c, const std::vector<bvh::GpuBvhLayout>& layouts) {
+  for (bvh::GpuBvhLayout layout : layouts)
     for (bool any_hit : {false, true})
       for (bool coherent : {true, false}) {
         std::string name = fmt::format("raycast/gpu/{}/{}/{}", any_hit ? "any" : "closest",
                                        coherent ? "coherent" : "incoherent", c.scene);
-        if (layout != gpu::GpuBvhLayout::Auto) name += std::string("/") + gpu::to_string(layout);
+        if (layout != bvh::GpuBvhLayout::Auto) name += std::string("/") + bvh::to_string(layout);
         benchmark::RegisterBenchmark(name.c_str(), [c, any_hit, coherent, layout](benchmark::State& st) {
           run_gpu_raycast(st, c, any_hit, coherent, layout);
         })->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(20);  // each re-uploads the rays (untimed)

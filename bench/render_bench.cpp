@@ -10,7 +10,7 @@
 #include "pathbench/common/film.h"
 #include "pathbench/common/report.h"
 #include "pathbench/run/energy.h"
-#include "pathbench/run/prepared.h"
+#include "pathbench/run/built_scene.h"
 #include "pathbench/run/run.h"
 #include "bench_context.h"
 #include "bench_ranks.h"
@@ -63,15 +63,15 @@ uint64_t queue_bytes_of(const RunReport& r) {
 
 // The case's scene built once on its device (kept in the scene cache for the benchmark's
 // repetitions); null where the case renders as other presets do, or under MPI ranks.
-std::shared_ptr<const run::PreparedScene> prepared_scene(const RenderCase& c, const Scene& scene) {
+std::shared_ptr<const run::BuiltScene> prepared_scene(const RenderCase& c, const Scene& scene) {
   if (!c.build_once || bench_ranks() > 1) return nullptr;
   const RenderSettings& s = c.settings;
   const std::string kind = fmt::format("prepared:{}:{}:{}:{}", to_string(s.device), int(s.instancing),
                                        int(s.watertight), int(s.embree_layout));
-  auto prep = std::static_pointer_cast<const run::PreparedScene>(cached_extra(c.scene, kind));
+  auto prep = std::static_pointer_cast<const run::BuiltScene>(cached_extra(c.scene, kind));
   if (!prep) {
-    prep = std::make_shared<const run::PreparedScene>(scene, s);
-    store_extra(c.scene, kind, std::const_pointer_cast<run::PreparedScene>(prep));
+    prep = std::make_shared<const run::BuiltScene>(scene, s);
+    store_extra(c.scene, kind, std::const_pointer_cast<run::BuiltScene>(prep));
   }
   return prep;
 }
@@ -92,7 +92,7 @@ void run_render(benchmark::State& state, const RenderCase& c) {
     state.SkipWithError(fmt::format("scene not available: {}", e.what()).c_str());
     return;
   }
-  std::shared_ptr<const run::PreparedScene> prepared;
+  std::shared_ptr<const run::BuiltScene> prepared;
   try {
     prepared = prepared_scene(c, *scene);
   } catch (const std::exception& e) {

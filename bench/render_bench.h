@@ -35,7 +35,7 @@ struct RenderCase {
                             // iteration rebuilds the BVH (untimed), so big scenes want few.
   std::string name;         // the benchmark's name; "" = render/<device>/... as below (the suite names its own)
   // The suite's cases (issue 28): the device's structure (Embree scene, GPU BVH) is built once
-  // per benchmark (run::PreparedScene, kept for its repetitions) and every iteration renders a
+  // per benchmark (run::BuiltScene, kept for its repetitions) and every iteration renders a
   // frame on it, so the energy window holds frames only; the build's seconds are the counter
   // build_seconds. Other presets keep one full render (build included, untimed) per iteration.
   bool build_once = false;

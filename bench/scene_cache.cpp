@@ -2,7 +2,7 @@
 
 #include <map>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb::bench {
 

@@ -7,8 +7,8 @@ test (tests/unit/test_statistical_render.cpp); with --scene cornell-box:VARIANT
     .venv/bin/python tools/make_reference.py            # 32 passes x 512 spp (~20 min on 2 cores)
     .venv/bin/python tools/make_reference.py --passes 8 --spp 64 --out-dir /tmp/ref   # quick
 
-Renders K independent passes (Mitsuba seeds 0 .. K-1) of the scene in
-tools/mitsuba_scene.py, then writes
+Renders K independent passes (Mitsuba seeds 0 .. K-1) of the scene as pathbench exports
+it (tools/mitsuba_scene.py), then writes
     <out-dir>/<scene>-nee-ref.pfm       per-pixel mean over the passes (RGB float)
     <out-dir>/<scene>-nee-ref-var.pfm   variance of that mean: sample variance of
                                          the pass images / K

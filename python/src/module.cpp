@@ -17,7 +17,8 @@
 #include "arguments.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/mitsuba_export.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/common/scene_warnings.h"
 #include "pathbench/run/run.h"
 #include "ray_cast.h"
@@ -135,6 +136,30 @@ std::shared_ptr<SceneHandle> load(const py::handle& name_or_path, float scale, s
 }  // namespace
 }  // namespace pb::py_bind
 
+// The scene as Mitsuba 3 XML + PLY (pb::write_mitsuba_scene, the one exporter); returns
+// the path of scene.xml.
+py::str export_mitsuba(const py::handle& scene, const py::handle& folder, const py::handle& width,
+                       const py::handle& height, const py::handle& bounces, const py::handle& converged) {
+  const pb::Scene& s = pb::python::scene_arg(scene, "scene").scene();
+  const std::string dir = pb::python::path_arg(folder, "folder");
+  pb::RenderSettings rs;
+  constexpr int64_t kMaxSide = std::numeric_limits<uint32_t>::max();
+  rs.width = uint32_t(pb::python::int_arg(width, "width", 1, kMaxSide));
+  rs.height = uint32_t(pb::python::int_arg(height, "height", 1, kMaxSide));
+  if (pb::python::bool_arg(converged, "converged")) {
+    if (!bounces.is_none()) throw py::value_error("bounces and converged=True exclude each other (converged: unbounded)");
+    rs.max_bounces = -1;  // as `--converged`: unbounded, ended by Russian roulette
+    rs.russian_roulette = true;
+  } else if (!bounces.is_none()) {
+    rs.max_bounces = int32_t(pb::python::int_arg(bounces, "bounces", 0, std::numeric_limits<int32_t>::max() - 1));
+  }
+  try {
+    return pb::python::text(pb::write_mitsuba_scene(s, rs, dir));
+  } catch (const pb::InputError& e) {  // a folder that cannot be written
+    throw py::value_error(e.what());
+  }
+}
+
 PYBIND11_MODULE(_core, m) {
   using namespace pb::py_bind;
   using pb::python::SceneHandle;
@@ -232,6 +257,12 @@ PYBIND11_MODULE(_core, m) {
         "`--embree-layout` (auto, triangles, quads) for the CPU ray casts. What the file holds that pathbench\n"
         "does not model is a UserWarning, or with strict=True (`render --strict`) a ValueError. ValueError\n"
         "names what is wrong.");
+  m.def("export_mitsuba", &export_mitsuba, py::arg("scene"), py::arg("folder"), py::arg("width"), py::arg("height"),
+        py::kw_only(), py::arg("bounces") = py::none(), py::arg("converged") = false,
+        "The scene as a Mitsuba 3 scene: folder/scene.xml and one binary PLY per material, each material as\n"
+        "the Mitsuba plugin its pathbench BSDF is defined as, the camera as a perspective sensor, a path\n"
+        "integrator for `bounces` (default 2; converged=True: unbounded with Russian roulette), as\n"
+        "`pathbench crosscheck` writes it. Returns the path of scene.xml.");
   m.def("builtin_scenes", [] {
     py::list out;
     for (const auto& b : pb::builtin_scenes()) out.append(py::make_tuple(b.name, b.description));  // ASCII

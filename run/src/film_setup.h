@@ -20,7 +20,7 @@ void prepare_film(const Scene& scene, const RenderSettings& s, const RunOptions&
 void check_for_tracer(const RenderSettings& s);
 // Everything render() does around the tracer call `trace` (which fills the tracer's fields
 // of `report`): checks, film, report fields, load, energy, fingerprint, film hash. render()
-// and PreparedScene::render (prepared.h) differ only in `trace`.
+// and BuiltScene::render (built_scene.h) differ only in `trace`.
 void render_with(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options,
                  const std::function<void()>& trace);
 

@@ -17,13 +17,10 @@
 
 #include "pathbench/common/film.h"
 
-namespace pb::gpu {
-class DeviceFilm;
-}
-
 namespace pb::run {
 
 class World;
+class DeviceFilm;  // tracer.h: a GPU rank's film on its device
 
 struct GpuReduction {
   bool nccl = false;   // the GPU ranks' films are reduced through NCCL (every rank knows)
@@ -69,27 +66,27 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index);
 // `band_root`: this rank is the root of a banded reduction (below): its receive buffer (a
 // second film on its GPU: the banded reduction is out of place, so that the ranks' own
 // films stay for MPI's checked sum where the bound refuses) is allocated here.
-void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film, bool band_root = false);
+void warm_gpu_reduction(const GpuReduction& r, DeviceFilm* film, bool band_root = false);
 
 // Banded (r.nccl, every rank a GPU rank): starts the reduction of rows [first_row,
 // first_row + rows) of the GPU ranks' device films into the root's receive buffer and, on
 // the root, its download into `host` (page-locked: PinnedFilm), on NCCL's stream; returns
 // at once. Every GPU rank calls it for the same bands in the same order, after tracing
 // them (a rank that traced nothing too).
-void reduce_gpu_band(const GpuReduction& r, gpu::DeviceFilm* film, Film& host, bool root, uint32_t first_row,
+void reduce_gpu_band(const GpuReduction& r, DeviceFilm* film, Film& host, bool root, uint32_t first_row,
                      uint32_t rows);
 // After the last band: the overflow bound over every rank (collective), then waits for the
 // bands' reductions. True: `host` on the root holds the GPU ranks' sums and counts; false:
 // the bound refused, nothing of the banded sums may be used (every rank's device film is
 // untouched: download them and add them through MPI's checked sum).
-bool finish_gpu_bands(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+bool finish_gpu_bands(World& w, const GpuReduction& r, DeviceFilm* film, double& bound_seconds,
                       double& wait_seconds);
 
 // Collective over every rank, after the frame (r.nccl only): GPU ranks pass their device
 // film, others null. True (on every rank) when the GPUs' films were added onto r.root's
 // device film; false when the overflow bound refused (then nothing was added). `seconds`
 // gets the time of the bound check and of NCCL's reduction on this rank.
-bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+bool reduce_gpu_films(World& w, const GpuReduction& r, DeviceFilm* film, double& bound_seconds,
                       double& nccl_seconds);
 
 // While it lives, `film`'s host arrays are page-locked for the device's copies (the one

@@ -14,8 +14,8 @@
 #include "gpu_reduce.h"
 #include "mpi_detail.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/gpu/render.h"
 #include "pathbench/run/ranks.h"
+#include "pathbench/run/tracer.h"
 #include "pathbench/run/world.h"
 
 namespace pb::run {
@@ -120,8 +120,8 @@ GpuReduction prepare_gpu_reduction(World& w, bool gpu, int gpu_index) {
 
 namespace {
 // Adds the GPU ranks' device films onto the GPU communicator's rank 0, in place there.
-void nccl_reduce(gpu::DeviceFilm& film) {
-  const gpu::DeviceFilm::Arrays a = film.arrays();
+void nccl_reduce(DeviceFilm& film) {
+  const DeviceFilm::Arrays a = film.arrays();
   nccl_check(ncclGroupStart(), "ncclGroupStart");
   nccl_check(ncclReduce(a.sums, a.sums, a.pixels * 3, ncclInt64, ncclSum, 0, current->nccl, current->stream),
              "ncclReduce (sums)");
@@ -139,7 +139,7 @@ namespace {
 // The overflow bound (collective over every rank): every partial sum of the GPU ranks' films
 // stays below the sum of the ranks' largest |sums|; true where that is below 2^63 (every rank
 // sees the same values, so all agree).
-bool films_cannot_overflow(World& w, gpu::DeviceFilm* film) {
+bool films_cannot_overflow(World& w, DeviceFilm* film) {
   const uint64_t largest = film ? film->max_abs_sum() : 0;
   std::vector<uint64_t> all(size_t(w.size()), 0);
   MPI_Allgather(&largest, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD);
@@ -158,12 +158,12 @@ struct RecvLayout {
 };
 }  // namespace
 
-void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film, bool band_root) {
+void warm_gpu_reduction(const GpuReduction& r, DeviceFilm* film, bool band_root) {
   if (!r.nccl || !current || !film) return;
   (void)film->max_abs_sum();
   nccl_reduce(*film);  // zeros onto zeros: the root's film stays cleared
   if (!band_root) return;
-  const gpu::DeviceFilm::Arrays a = film->arrays();
+  const DeviceFilm::Arrays a = film->arrays();
   const RecvLayout at(a.pixels, a.sum_sq != nullptr);
   if (current->recv_bytes >= at.bytes) return;
   if (current->recv) cuda_check(cudaFree(current->recv), "cudaFree (the banded reduction's receive buffer)");
@@ -175,10 +175,10 @@ void warm_gpu_reduction(const GpuReduction& r, gpu::DeviceFilm* film, bool band_
   current->recv_bytes = at.bytes;
 }
 
-void reduce_gpu_band(const GpuReduction& r, gpu::DeviceFilm* film, Film& host, bool root, uint32_t first_row,
+void reduce_gpu_band(const GpuReduction& r, DeviceFilm* film, Film& host, bool root, uint32_t first_row,
                      uint32_t rows) {
   if (!r.nccl || !current || !film || rows == 0) return;
-  const gpu::DeviceFilm::Arrays a = film->arrays();
+  const DeviceFilm::Arrays a = film->arrays();
   const RecvLayout at(a.pixels, a.sum_sq != nullptr);
   if (uint64_t(first_row) + rows > host.height() || a.pixels != host.pixels())
     throw std::logic_error("reduce_gpu_band: the band lies outside the film");
@@ -208,7 +208,7 @@ void reduce_gpu_band(const GpuReduction& r, gpu::DeviceFilm* film, Film& host, b
                "cudaMemcpyAsync (a band's variance sums)");
 }
 
-bool finish_gpu_bands(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+bool finish_gpu_bands(World& w, const GpuReduction& r, DeviceFilm* film, double& bound_seconds,
                       double& wait_seconds) {
   using Clock = std::chrono::steady_clock;
   bound_seconds = wait_seconds = 0;
@@ -224,7 +224,7 @@ bool finish_gpu_bands(World& w, const GpuReduction& r, gpu::DeviceFilm* film, do
   return safe;
 }
 
-bool reduce_gpu_films(World& w, const GpuReduction& r, gpu::DeviceFilm* film, double& bound_seconds,
+bool reduce_gpu_films(World& w, const GpuReduction& r, DeviceFilm* film, double& bound_seconds,
                       double& nccl_seconds) {
   using Clock = std::chrono::steady_clock;
   bound_seconds = nccl_seconds = 0;

@@ -4,51 +4,32 @@
 
 #include <fmt/core.h>
 
-#include "pathbench/common/errors.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/bvh/host_tracer.h"
-#if PATHBENCH_HAVE_CUDA
-#include "pathbench/gpu/render.h"
-#endif
+#include "pathbench/common/errors.h"
 
 namespace pb::run {
 
-struct RankTracer::Cpu {
-  std::unique_ptr<cpu::EmbreeScene> scene;    // the CPU tracer's, or
-  std::unique_ptr<gpu::HostGpuTracer> gpu_bvh;  // the GPU's samples on this CPU
-};
-
-struct RankTracer::Gpu {
-#if PATHBENCH_HAVE_CUDA
-  Gpu(const Scene& s, Instancing instancing) : scene(s, instancing) {}
-  gpu::GpuScene scene;
-  gpu::DeviceFilm film;  // every block's samples, downloaded once (finish)
-#endif
-};
-
 RankTracer::RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options, bool gpu_samples)
-    : scene_(scene), settings_(settings), options_(options) {
+    : settings_(settings), options_(options) {
   settings_.validate();
-  if (settings_.device == Device::Cpu) {
-    // Built once for every chunk (a million-triangle scene takes Embree a second).
-    cpu_ = std::make_unique<Cpu>();
-    if (gpu_samples) cpu_->gpu_bvh = std::make_unique<gpu::HostGpuTracer>(scene, settings_.instancing);
-    else cpu_->scene = cpu::make_embree_scene(scene, settings_.watertight, settings_.embree_layout,
-                                                      settings_.instancing);
-  } else {
-    std::string why;
-    if (!gpu_available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
-#if PATHBENCH_HAVE_CUDA
-    gpu_ = std::make_unique<Gpu>(scene, settings_.instancing);  // BVH built and uploaded once for every chunk
-#endif
+  if (settings_.device == Device::Cpu && gpu_samples) {
+    host_bvh_ = std::make_unique<bvh::HostGpuTracer>(scene, settings_.instancing);
+    return;
   }
+  const Tracer& t = run::tracer(settings_.device);
+  std::string why;
+  if (!t.available(&why)) throw InputError(fmt::format("--device gpu: {}", why));
+  // Built once for every chunk (a million-triangle scene takes Embree a second; the GPU's
+  // BVH is built and uploaded once).
+  scene_ = t.prepare(scene, settings_);
+  device_film_ = t.make_device_film();
 }
 
 RankTracer::~RankTracer() = default;
 
 const char* RankTracer::tracer() const {
-  if (!cpu_) return "gpu";
-  return cpu_->gpu_bvh ? "gpu-bvh-on-host" : "embree";
+  if (host_bvh_) return "gpu-bvh-on-host";
+  return settings_.device == Device::Gpu ? "gpu" : "embree";
 }
 
 void RankTracer::trace(const FrameBlock& block, Film& film, RunReport& report) {
@@ -59,22 +40,19 @@ void RankTracer::trace(const FrameBlock& block, Film& film, RunReport& report) {
   s.sample_count = block.samples;
   s.progress = false;  // ranks' bars would interleave on one terminal
   RunReport chunk;
-  if (s.device == Device::Cpu && cpu_->gpu_bvh) {
+  if (host_bvh_) {
     if (chunks_ == 0) {  // what cpu::render reports of itself
       chunk.settings = s;
       chunk.threads = s.threads > 0 ? s.threads : hardware_threads();
       chunk.extra["tracer"] = tracer();
-      chunk.extra["bvh_layout"] = cpu_->gpu_bvh->layout();
+      chunk.extra["bvh_layout"] = host_bvh_->layout();
     }
-    cpu_->gpu_bvh->render(s, film, chunk);  // Film::add accumulates into the rank's film
-    chunk.tracer_host_bytes = film.bytes() + cpu_->gpu_bvh->bvh_bytes();
-  } else if (s.device == Device::Cpu) {
-    cpu::render(scene_, *cpu_->scene, s, film, chunk);  // Film::add accumulates into the rank's film
+    host_bvh_->render(s, film, chunk);  // Film::add accumulates into the rank's film
+    chunk.tracer_host_bytes = film.bytes() + host_bvh_->bvh_bytes();
   } else {
-#if PATHBENCH_HAVE_CUDA
-    // Every block adds into the device's film; it comes back once, in finish().
-    gpu::render(scene_, gpu_->scene, s, film, chunk, options_.profile, &gpu_->film);
-#endif
+    // The CPU adds into the rank's film; a GPU adds every block into its device film,
+    // which comes back once, in finish().
+    scene_->render(s, film, chunk, options_.profile, device_film_.get());
   }
   // The first chunk's description (device, memory, layout) stands for the rank's;
   // counts and times add up over chunks.
@@ -95,44 +73,32 @@ void RankTracer::trace(const FrameBlock& block, Film& film, RunReport& report) {
 }
 
 void RankTracer::warm_up(Film& film) {
-#if PATHBENCH_HAVE_CUDA
-  if (!gpu_) return;
+  if (!device_film_) return;
   // One sample of the first row into the device film (kernels loaded, the film allocated
   // and touched), then cleared: `film` itself is not written.
   RenderSettings w = settings_;
   w.row_count = w.sample_count = 1;
   w.progress = false;
   RunReport ignored;
-  gpu::render(scene_, gpu_->scene, w, film, ignored, false, &gpu_->film);
-  gpu_->film.clear();
-#else
-  (void)film;
-#endif
+  scene_->render(w, film, ignored, false, device_film_.get());
+  device_film_->clear();
 }
 
 void RankTracer::finish(Film& film, RunReport& report) {
-#if PATHBENCH_HAVE_CUDA
-  if (gpu_ && gpu_->film.used()) report.extra["film_download_seconds"] = gpu_->film.download(film);
-#else
-  (void)film, (void)report;
-#endif
+  if (device_film_ && device_film_->used()) report.extra["film_download_seconds"] = device_film_->download(film);
 }
 
 double RankTracer::calibrate(const FrameBlock& block, Film& film, float max_emission) {
   RunReport probe;
   trace(block, film, probe);
   chunks_ = 0;  // the frame's first block describes the rank
-#if PATHBENCH_HAVE_CUDA
-  if (gpu_) gpu_->film.clear();
-#endif
-  if (!gpu_) film.begin(settings_.spp, max_emission);
+  if (device_film_) device_film_->clear();
+  else film.begin(settings_.spp, max_emission);
   return probe.seconds;
 }
 
-gpu::DeviceFilm* RankTracer::device_film() {
-#if PATHBENCH_HAVE_CUDA
-  if (gpu_ && gpu_->film.used()) return &gpu_->film;
-#endif
+DeviceFilm* RankTracer::device_film() {
+  if (device_film_ && device_film_->used()) return device_film_.get();
   return nullptr;
 }
 

@@ -9,9 +9,10 @@
 #include "pathbench/common/settings.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
+#include "pathbench/run/tracer.h"
 
-namespace pb::gpu {
-class DeviceFilm;
+namespace pb::bvh {
+class HostGpuTracer;
 }
 
 namespace pb::run {
@@ -20,7 +21,7 @@ class RankTracer {
  public:
   // Validates `settings`, checks the device, and on the GPU uploads the scene once.
   // Throws InputError like run::render. `gpu_samples`: a CPU rank in a frame with GPU
-  // ranks traces the GPU's samples bit for bit (gpu/host_tracer.h), not Embree's, so
+  // ranks traces the GPU's samples bit for bit (bvh/host_tracer.h), not Embree's, so
   // that the image does not depend on which device took which samples.
   RankTracer(const Scene& scene, const RenderSettings& settings, const RunOptions& options, bool gpu_samples = false);
   // What traces this rank's samples: "embree", "gpu", or "gpu-bvh-on-host".
@@ -42,16 +43,14 @@ class RankTracer {
   void finish(Film& film, RunReport& report);
   // A GPU rank's film on the device (what finish() downloads), for a reduction on the
   // GPUs; null on a CPU rank or before the first block.
-  gpu::DeviceFilm* device_film();
+  DeviceFilm* device_film();
 
  private:
-  const Scene& scene_;
   RenderSettings settings_;
   RunOptions options_;
-  struct Cpu;  // the Embree scene, or the GPU's BVH on the host
-  struct Gpu;  // the uploaded scene and BVH, and the film on the device
-  std::unique_ptr<Cpu> cpu_;
-  std::unique_ptr<Gpu> gpu_;
+  std::unique_ptr<PreparedScene> scene_;           // Embree's scene or the GPU's uploaded BVH (tracer.h), or
+  std::unique_ptr<bvh::HostGpuTracer> host_bvh_;  // the GPU's samples on this CPU
+  std::unique_ptr<DeviceFilm> device_film_;        // a GPU rank's: every block's samples, downloaded once (finish)
   int chunks_ = 0;
 };
 

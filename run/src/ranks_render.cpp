@@ -21,9 +21,7 @@
 #include "film_setup.h"
 #include "gpu_reduce.h"
 #include "rank_tracer.h"
-#if PATHBENCH_HAVE_CUDA
-#include "pathbench/gpu/render.h"
-#endif
+#include "pathbench/run/tracer.h"
 
 namespace pb::run {
 
@@ -63,11 +61,7 @@ int cpu_share(const std::vector<std::string>& local_devices) {
 }
 
 int gpu_count() {
-#if PATHBENCH_HAVE_CUDA
-  return gpu::device_count();  // no context yet: the rank has not picked its GPU
-#else
-  return 0;
-#endif
+  return gpu_tracer().device_count();  // no context yet: the rank has not picked its GPU
 }
 }  // namespace
 
@@ -136,10 +130,8 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   std::unique_ptr<RankTracer> tracer;
   int gpu_index = -1;
   on_every_rank([&] {
-#if PATHBENCH_HAVE_CUDA
     // Before any other CUDA call (RankTracer's device check), so the rank's context is on its GPU.
-    if (s.device == Device::Gpu) gpu_index = gpu::select_device(w.local_rank());
-#endif
+    if (s.device == Device::Gpu) gpu_index = gpu_tracer().select_device(w.local_rank());
     if (s.device == Device::Cpu && s.threads == 0) s.threads = cpu_share(local_devices);
     // A CPU rank beside GPU ranks traces the GPU's samples, bit for bit (the hybrid's
     // image is then one GPU's, whichever rank took which chunk).

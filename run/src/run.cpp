@@ -6,25 +6,15 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/cpu/render.h"
 #include "pathbench/run/energy.h"
 #include "pathbench/run/film_hash.h"
 #include "pathbench/run/run_context.h"
+#include "pathbench/run/tracer.h"
 #include "film_setup.h"
-#if PATHBENCH_HAVE_CUDA
-#include "pathbench/gpu/render.h"
-#endif
 
 namespace pb::run {
 
-bool gpu_available(std::string* why_not) {
-#if PATHBENCH_HAVE_CUDA
-  return pb::gpu::device_available(why_not);
-#else
-  if (why_not) *why_not = "this build has no CUDA tracer (configure with -DPATHBENCH_CUDA=ON and nvcc on PATH)";
-  return false;
-#endif
-}
+bool gpu_available(std::string* why_not) { return gpu_tracer().available(why_not); }
 
 // A film where most samples were discarded (NaN, infinite, or beyond its fixed-point
 // range) is wrong, not noisy: fail rather than write it. Within the supported emission
@@ -50,15 +40,8 @@ void check_for_tracer(const RenderSettings& s) {
 }
 
 void render(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options) {
-  render_with(scene, s, film, report, options, [&] {
-    if (s.device == Device::Cpu) {
-      cpu::render(scene, s, film, report);
-    } else {
-#if PATHBENCH_HAVE_CUDA
-      gpu::render(scene, s, film, report, options.profile);
-#endif
-    }
-  });
+  render_with(scene, s, film, report, options,
+              [&] { tracer(s.device).render(scene, s, film, report, options.profile); });
 }
 
 void render_with(const Scene& scene, const RenderSettings& s, Film& film, RunReport& report, const RunOptions& options,
@@ -102,10 +85,7 @@ Rendered render(const Scene& scene, const RenderSettings& settings, const RunOpt
 double render_seconds(const RunReport& r) { return r.settings.device == Device::Gpu ? r.device_seconds : r.seconds; }
 
 std::string machine_folder(Device device) {
-#if PATHBENCH_HAVE_CUDA
-  if (device == Device::Gpu) return gpu::device_info().slug;
-#endif
-  (void)device;
+  if (device == Device::Gpu) return gpu_tracer().machine_slug();
   return machine_slug();
 }
 

@@ -6,9 +6,7 @@
 #include "pathbench/common/fingerprint.h"
 #include "pathbench/cpu/embree_facts.h"
 #include "pathbench/run/run.h"
-#if PATHBENCH_HAVE_CUDA
-#include "pathbench/gpu/device_facts.h"
-#endif
+#include "pathbench/run/tracer.h"
 
 namespace pb::run {
 
@@ -21,15 +19,11 @@ nlohmann::json run_fingerprint(bool with_gpu) {
   fp["tbb"] = et["tbb"];
   if (!with_gpu) return fp;
   std::string why;
-#if PATHBENCH_HAVE_CUDA
   if (gpu_available(&why)) {
-    static const nlohmann::json gpu_facts = gpu::device_fingerprint();  // NVML is opened once per process
+    static const nlohmann::json gpu_facts = gpu_tracer().fingerprint();  // NVML is opened once per process
     fp["gpu"] = gpu_facts;
     return fp;
   }
-#else
-  gpu_available(&why);
-#endif
   fp["gpu"] = {{"none", why}};
   return fp;
 }

@@ -111,7 +111,7 @@ def large_mesh(levels: int) -> dict:
 
 
 def cornell_materials() -> dict:
-    """The Cornell box (common/src/scenes/cornell_box.cpp, millimetres) with a rough-copper
+    """The Cornell box (scene_io/src/scenes/cornell_box.cpp, millimetres) with a rough-copper
     (GGX) tall block, a glass short block and a mirror cube (../cube.obj) turned 45 degrees
     at the front left, showing the red and green walls."""
     def quad(a, b, c, d, m):

@@ -12,7 +12,7 @@
 #include <cstddef>
 
 #include "fuzz_util.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace {
 
@@ -40,6 +40,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const bool binary = form == 'b';
   const std::string text = binary ? input.substr(1) : form == 'd' || form == 'r' ? expanded(input) : input;
   const pb::scene_io::FileReader reader = pb::fuzz::memory_reader([&](const std::string&) { return text; });
-  pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene_gltf(binary ? "fuzz/s.glb" : "fuzz/s.gltf", text, binary, reader); });
+  pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene(binary ? "fuzz/s.glb" : "fuzz/s.gltf", text, reader); });
   return 0;
 }

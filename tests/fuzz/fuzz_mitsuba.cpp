@@ -3,7 +3,7 @@
 // the XML, transforms, BSDFs and instancing, not the file system); names containing
 // "missing" do not exist.
 #include "fuzz_util.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace {
 
@@ -19,6 +19,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return path.size() > 4 && path.substr(path.size() - 4) == ".ply" ? kPly : kObj;
   });
   const std::string text = pb::fuzz::text_of(data, size);
-  pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene_mitsuba("fuzz/scene.xml", text, reader); });
+  pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene("fuzz/scene.xml", text, reader); });
   return 0;
 }

@@ -3,7 +3,7 @@
 // the transforms and the range checks, not the file system).
 #include "fuzz_util.h"
 #include "pathbench/common/limits.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace {
 
@@ -17,6 +17,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // A mesh named "missing..." does not exist; every other name is the cube.
   static const pb::scene_io::FileReader reader = pb::fuzz::memory_reader([](const std::string&) { return kCube; });
   const std::string text = pb::fuzz::text_of(data, size);
-  pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene_json("fuzz/scene.json", text, reader); });
+  pb::fuzz::expect_clean([&] { pb::scene_io::parse_scene("fuzz/scene.json", text, reader); });
   return 0;
 }

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "pathbench/common/errors.h"
-#include "scene_io/scene_io.h"
+#include "readers/readers.h"
 
 namespace pb::fuzz {
 

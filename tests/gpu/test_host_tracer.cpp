@@ -12,7 +12,7 @@
 
 #include "film_agreement.h"
 #include "pathbench/bvh/host_tracer.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/cpu/embree_facts.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"

@@ -16,7 +16,7 @@
 #include "pathbench/bvh/bvh_build.h"
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "traversal_check.h"
 
 namespace pb::bvh {

@@ -1,63 +1,57 @@
-"""tools/mitsuba_cornell_box.py and mitsuba_scene.material_bsdf: pathbench's cornell-box
-variants as Mitsuba 3 scenes, each material exported as the Mitsuba plugin pathbench's
-BSDF of that kind is defined as. The data tests need no Mitsuba; the rest skip without it."""
+"""pathbench's cornell-box variants as Mitsuba 3 scenes (pathbench.export_mitsuba, through
+tools/mitsuba_scene.py): each material exported as the Mitsuba plugin pathbench's BSDF of
+that kind is defined as (scene_io/src/mitsuba_export.cpp, the one definition of that
+mapping). The XML tests need no Mitsuba; the rest skip without it."""
+import xml.etree.ElementTree as ET
+
 import numpy as np
 import pytest
 
-import mitsuba_cornell_box as cb
 import mitsuba_scene as ms
 
-
-def normals(verts, faces):
-    v = np.asarray(verts, dtype=float)
-    f = np.asarray(faces)
-    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
+VARIANTS = ["", "mirror", "glass", "spheres", "ggx"]
 
 
-def test_room_and_blocks_as_pathbench():
-    parts = {name: (verts, faces, m) for name, verts, faces, m in cb.parts("")}
-    assert sum(len(f) for _, f, _ in parts.values()) == 38  # as pathbench's `cornell-box`
-    assert np.allclose(normals(*parts["light"][:2]), [0, -1, 0])
-    assert parts["light"][2]["emission"] == (17.0, 12.0, 4.0)
+def bsdfs(tmp_path, variant):
+    """The outermost BSDF plugin of every shape, with the inner one where it is two-sided."""
+    root = ET.parse(ms.write_xml(tmp_path, "cornell-box" + (":" + variant if variant else ""), 16, 16, 5)).getroot()
+    out = []
+    for shape in root.findall("shape"):
+        b = shape.find("bsdf")
+        inner = b.find("bsdf") if b.get("type") == "twosided" else None
+        out.append((b, inner, shape.find("emitter")))
+    return out
 
 
-@pytest.mark.parametrize("variant, kinds", [
-    ("mirror", {"diffuse", "mirror"}), ("glass", {"diffuse", "dielectric"}),
-    ("spheres", {"diffuse", "mirror", "dielectric"}), ("ggx", {"diffuse", "roughconductor"})])
-def test_variants_use_their_kinds(variant, kinds):
-    assert {m["kind"] for *_, m in cb.parts(variant)} == kinds
+def test_room_as_pathbench(tmp_path):
+    shapes = bsdfs(tmp_path, "")
+    emitters = [e for *_, e in shapes if e is not None]
+    assert len(emitters) == 1 and emitters[0].find("rgb").get("value").replace(" ", "") == "17,12,4"
+    assert {(b.get("type"), i.get("type")) for b, i, _ in shapes} == {("twosided", "diffuse")}
 
 
-def test_icosphere_is_closed_outward_and_on_the_sphere():
-    verts, faces = cb.icosphere((1.0, 2.0, 3.0), 2.0, 3)
-    assert len(faces) == 20 * 4 ** 3 and len(verts) == 10 * 4 ** 3 + 2
-    v = np.asarray(verts)
-    assert np.allclose(np.linalg.norm(v - [1, 2, 3], axis=1), 2.0, rtol=1e-6)
-    f = np.asarray(faces)
-    centres = v[f].mean(axis=1) - [1, 2, 3]
-    assert (np.einsum("ij,ij->i", normals(verts, faces), centres) > 0).all(), "normals point outwards"
-    edges = {}
-    for a, b, c in faces:
-        for e in ((a, b), (b, c), (c, a)):
-            edges[tuple(sorted(e))] = edges.get(tuple(sorted(e)), 0) + 1
-    assert set(edges.values()) == {2}, "every edge shared by two triangles: closed"
+@pytest.mark.parametrize("variant, plugins", [
+    ("mirror", {"diffuse", "conductor"}), ("glass", {"diffuse", "dielectric"}),
+    ("spheres", {"diffuse", "conductor", "dielectric"}), ("ggx", {"diffuse", "roughconductor"})])
+def test_variants_use_their_plugins(tmp_path, variant, plugins):
+    assert {(i if i is not None else b).get("type") for b, i, _ in bsdfs(tmp_path, variant)} == plugins
 
 
-def test_unknown_variant():
-    with pytest.raises(ValueError, match="unknown variant"):
-        cb.parts("chrome")
-
-
-def test_material_export_matches_mitsubas_plugins():
-    assert ms.material_bsdf(cb.WHITE) == {"type": "twosided", "material": ms._bsdf((0.75, 0.75, 0.75))}
-    mirror = ms.material_bsdf(cb.MIRROR)["material"]
-    assert mirror["type"] == "conductor" and mirror["material"] == "none"
-    glass = ms.material_bsdf(cb.GLASS)
-    assert glass["type"] == "dielectric" and glass["int_ior"] == 1.5 and glass["ext_ior"] == 1.0
-    rough = ms.material_bsdf(cb.COPPER)["material"]
-    assert (rough["type"], rough["distribution"], rough["alpha"], rough["material"]) == \
-        ("roughconductor", "ggx", 0.2, "none")
+def test_material_mapping(tmp_path):
+    """The plugin (and its parameters) each pathbench BSDF is defined as."""
+    found = {}
+    for variant in ("spheres", "ggx"):
+        for b, inner, _ in bsdfs(tmp_path / variant, variant):
+            found[(inner if inner is not None else b).get("type")] = (b, inner)
+    b, mirror = found["conductor"]
+    assert b.get("type") == "twosided" and mirror.find("string[@name='material']").get("value") == "none"
+    glass, _ = found["dielectric"]
+    assert float(glass.find("float[@name='int_ior']").get("value")) == 1.5
+    assert float(glass.find("float[@name='ext_ior']").get("value")) == 1.0
+    _, rough = found["roughconductor"]
+    assert rough.find("string[@name='distribution']").get("value") == "ggx"
+    assert float(rough.find("float[@name='alpha']").get("value")) == pytest.approx(0.2)
+    assert rough.find("string[@name='material']").get("value") == "none"
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +64,7 @@ def mi():
 
 
 def test_every_variant_loads_and_renders(mi):
-    for variant in cb.VARIANTS:
+    for variant in VARIANTS:
         scene = ms.load_scene(mi, width=16, height=16, spp=4, max_depth=5,
                               scene="cornell-box" + (":" + variant if variant else ""))
         assert len(scene.emitters()) == 1

@@ -1,7 +1,7 @@
-"""tools/mitsuba_scene.py: the Mitsuba 3 version of paper-cornell is the paper's scene
-(../shared/paper-scene.md) and is oriented like pathbench's image. Tests that need
-Mitsuba skip when it is not importable; the comparison with pathbench skips when no
-pathbench binary is built."""
+"""tools/mitsuba_scene.py: paper-cornell as pathbench exports it to Mitsuba 3
+(pathbench.export_mitsuba) is the paper's scene (../shared/paper-scene.md) and is
+oriented like pathbench's image. Tests that need Mitsuba skip when it is not importable;
+the comparison with pathbench skips when no pathbench binary is built."""
 import math
 import os
 import shutil
@@ -17,73 +17,42 @@ import mitsuba_scene as ms
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def normal(tri):
-    a, b, c = (np.array(ms.VERTICES[i], dtype=float) for i in tri)
-    n = np.cross(b - a, c - a)
-    return n / np.linalg.norm(n)
+# ---- The export (pathbench.export_mitsuba; no Mitsuba needed) -----------------------
 
-
-# ---- The scene as data (no Mitsuba needed) ------------------------------------------
-
-def test_twelve_vertices_fourteen_triangles():
-    assert len(ms.VERTICES) == 12
-    assert ms.triangle_count() == 14
-    assert [name for name, *_ in ms.PARTS] == ["left", "back", "right", "ceiling", "floor", "front", "light"]
-
-
-def test_triangles_and_materials_as_the_paper():
-    parts = {name: (tris, albedo, emission) for name, tris, albedo, emission in ms.PARTS}
-    assert parts["left"] == ([(0, 1, 2), (0, 2, 3)], (0.5, 0.0, 0.0), None)
-    assert parts["right"] == ([(5, 7, 6), (5, 4, 7)], (0.0, 0.5, 0.0), None)
-    assert parts["light"][0] == [(10, 9, 8), (11, 10, 8)]
-    assert parts["light"][2] == (10.0, 10.0, 10.0)
-    for name in ("back", "ceiling", "floor", "front"):
-        assert parts[name][1] == (0.5, 0.5, 0.5)
-
-
-def test_light_faces_down_and_front_wall_faces_out():
-    for tri in dict((n, t) for n, t, *_ in ms.PARTS)["light"]:
-        assert np.allclose(normal(tri), [0, -1, 0])
-    for name, tris, *_ in ms.PARTS:
-        for tri in tris:
-            centre = np.mean([ms.VERTICES[i] for i in tri], axis=0)
-            inward = np.dot(normal(tri), np.array([0, 0, 6]) - centre) > 0  # box centre (0, 0, 6)
-            if name == "front":
-                assert not inward, "the front wall faces out of the box (two-sidedness matters)"
-            elif name != "light":
-                assert inward, name
-
-
-def test_camera():
-    assert ms.CAMERA_ORIGIN == (0, 0, 20)
-    assert ms.CAMERA_TARGET[2] < ms.CAMERA_ORIGIN[2] and ms.CAMERA_TARGET[:2] == (0, 0)
-    assert ms.CAMERA_UP == (0, 1, 0)
-    assert ms.FOV_DEG == pytest.approx(57.853, abs=1e-3)
-    assert math.tan(math.radians(ms.FOV_DEG / 2)) == pytest.approx(10.5 / 19)
-    assert ms.MAX_DEPTH == 3 and ms.WIDTH == ms.HEIGHT == 256
-
-
-def test_part_meshes_keep_their_own_vertices():
-    for _, tris, *_ in ms.PARTS:
-        verts, faces = ms.part_mesh(tris)
-        assert len(faces) == 2 and len(verts) == 4
-        assert [tuple(verts[i] for i in f) for f in faces] == [tuple(ms.VERTICES[i] for i in t) for t in tris]
+def ply_faces(path):
+    data = path.read_bytes()
+    header = data[: data.index(b"end_header")].decode()
+    return int(header.split("element face ")[1].split()[0])
 
 
 def test_xml_file(tmp_path):
-    path = ms.write_xml(tmp_path, spp=16)
+    """paper-cornell as pathbench exports it: one PLY per material (red, white, green, light),
+    14 triangles, the paper's camera (../shared/paper-scene.md), max_depth 3 for two bounces."""
+    path = ms.write_xml(tmp_path, width=32, height=16)
     root = ET.parse(path).getroot()
     shapes = root.findall("shape")
-    assert len(shapes) == 7
+    assert len(shapes) == 4
+    assert sum(ply_faces(tmp_path / s.find("string[@name='filename']").get("value")) for s in shapes) == 14
     assert root.find("integrator/integer[@name='max_depth']").get("value") == "3"
-    assert float(root.find("sensor/float[@name='fov']").get("value")) == pytest.approx(ms.FOV_DEG)
+    assert int(root.find("integrator/integer[@name='rr_depth']").get("value")) > 3, "no Russian roulette"
+    fov = float(root.find("sensor/float[@name='fov']").get("value"))
+    assert math.tan(math.radians(fov / 2)) == pytest.approx(10.5 / 19, rel=1e-6)
+    assert root.find("sensor/string[@name='fov_axis']").get("value") == "y"
+    look = root.find("sensor/transform/lookat")
+    assert [float(x) for x in look.get("origin").split(",")] == [0, 0, 20]
+    assert [float(x) for x in look.get("up").split(",")] == [0, 1, 0]
+    assert root.find("sensor/film/integer[@name='width']").get("value") == "32"
+    assert root.find("sensor/film/integer[@name='height']").get("value") == "16"
     assert root.find("sensor/film/rfilter").get("type") == "box"
-    faces = 0
-    for s in shapes:
-        data = (tmp_path / f"{s.get('id')}.ply").read_bytes()
-        header = data[: data.index(b"end_header")].decode()
-        faces += int(header.split("element face ")[1].split()[0])
-    assert faces == 14
+    emitters = [s for s in shapes if s.find("emitter") is not None]
+    assert len(emitters) == 1
+    assert emitters[0].find("emitter/rgb").get("value").replace(" ", "") == "10,10,10"
+
+
+def test_bounces_and_converged(tmp_path):
+    depth = lambda p: ET.parse(p).getroot().find("integrator/integer[@name='max_depth']").get("value")  # noqa: E731
+    assert depth(ms.write_xml(tmp_path / "a", max_depth=6)) == "6"
+    assert depth(ms.write_xml(tmp_path / "b", max_depth=-1)) == "-1"
 
 
 def test_pfm_round_trip_keeps_row_zero_at_the_top(tmp_path):
@@ -118,9 +87,8 @@ def scalar(x):
 def test_mitsuba_scene_has_14_triangles_and_one_emitter(mi):
     scene = ms.load_scene(mi, width=32, height=32, spp=4)
     shapes = scene.shapes()
-    assert len(shapes) == 7
+    assert len(shapes) == 4  # one mesh per material
     assert sum(s.face_count() for s in shapes) == 14
-    assert sum(s.vertex_count() for s in shapes) == 28
     assert len(scene.emitters()) == 1
     area = sum(scalar(s.surface_area()) for s in shapes if s.is_emitter())
     assert area == pytest.approx(60.0, rel=1e-5)
@@ -130,7 +98,8 @@ def test_mitsuba_camera(mi):
     scene = ms.load_scene(mi, width=32, height=32, spp=4)
     sensor = scene.sensors()[0]
     params = mi.traverse(sensor)
-    assert scalar(params["x_fov"]) == pytest.approx(ms.FOV_DEG, rel=1e-5)  # square image: x fov = y fov
+    fov = 2.0 * math.degrees(math.atan(10.5 / 19.0))  # ../shared/paper-scene.md
+    assert scalar(params["x_fov"]) == pytest.approx(fov, rel=1e-5)  # square image: x fov = y fov
     m = np.array(params["to_world"].matrix).reshape(4, 4)
     assert np.allclose(m[:3, 3], [0, 0, 20])   # position
     assert np.allclose(m[:3, 2], [0, 0, -1])   # Mitsuba cameras look along local +z
@@ -177,7 +146,7 @@ def test_mitsuba_matches_pathbench_orientation_and_mean(mi, tmp_path):
 
 
 def test_xml_file_loads_in_mitsuba(mi, tmp_path):
-    scene = mi.load_file(str(ms.write_xml(tmp_path, spp=4, width=16, height=16)))
+    scene = mi.load_file(str(ms.write_xml(tmp_path, width=16, height=16)))
     assert sum(s.face_count() for s in scene.shapes()) == 14
     assert len(scene.emitters()) == 1
     img = np.array(mi.render(scene, spp=4))[:, :, :3]

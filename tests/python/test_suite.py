@@ -295,7 +295,7 @@ def test_asking_for_a_gpu_where_there_is_none_is_bad_input(tmp_path):
 
 @needs_build
 def test_frames_on_a_scene_built_once_give_the_renders_image_and_fewer_repetitions_keep_names(tmp_path):
-    """The suite's benchmarks build the scene once (run::PreparedScene) and time frames on it:
+    """The suite's benchmarks build the scene once (run::BuiltScene) and time frames on it:
     the film hash is `pathbench render`'s for the same settings (which builds per call), every
     row carries build_seconds, and --repetitions-for runs those workloads in a pathbench-bench
     of their own, so their names stay the history's series (no /repeats:N)."""

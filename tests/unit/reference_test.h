@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/run/run.h"
 #include "stat_test.h"
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pathbench/analysis/accuracy_metrics.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 
 namespace pb::analysis {

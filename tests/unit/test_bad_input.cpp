@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/common/settings.h"
 #include "pathbench/run/run.h"
 

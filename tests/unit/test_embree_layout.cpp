@@ -10,7 +10,7 @@
 #include <random>
 #include <set>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/cpu/embree_layout.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/triangle_pairs.h"

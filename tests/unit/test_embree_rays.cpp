@@ -9,7 +9,7 @@
 
 #include "embree_rays.h"
 #include "pathbench/bvh/bvh_layout.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb::cpu {
 namespace {

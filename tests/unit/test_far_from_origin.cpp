@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "pathbench/common/path.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "reference_test.h"
 #include "stability_device.h"
 

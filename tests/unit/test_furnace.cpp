@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 #include "furnace_check.h"
 

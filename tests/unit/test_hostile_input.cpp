@@ -13,10 +13,10 @@
 #include "pathbench/analysis/bench_compare.h"
 #include "pathbench/run/run.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
+#include "pathbench/output/image_io.h"
 #include "pathbench/common/input_file.h"
 #include "pathbench/common/limits.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 namespace {

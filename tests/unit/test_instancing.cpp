@@ -16,7 +16,7 @@
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/host_tracer.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/cpu/isa.h"
 #include "pathbench/run/run.h"

@@ -2,7 +2,7 @@
 // `cornell-box:ggx` (GGX rough conductor) and `cornell-box:spheres` (mirror and glass
 // spheres), 64 x 64, 4 bounces, light sampling + MIS, compared per pixel with
 // independent Mitsuba references (tests/data/cornell-box-*-nee-ref*.pfm, made by
-// tools/make_reference.py from tools/mitsuba_cornell_box.py; see tests/data/README.md)
+// tools/make_reference.py; see tests/data/README.md)
 // by the same statistical test as test_statistical_render.cpp. Negative controls: a
 // GGX alpha of 0.3 instead of 0.2, and glass of ior 1.33 instead of 1.5, are rejected.
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <string>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "reference_test.h"
 
 namespace pb {

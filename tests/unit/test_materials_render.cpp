@@ -22,7 +22,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/features.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 #include "furnace_check.h"
 

@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/image_io.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/image_io.h"
+#include "pathbench/output/output_file.h"
 
 namespace fs = std::filesystem;
 

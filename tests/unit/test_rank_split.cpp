@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/ranks_render.h"
 #include "pathbench/run/ranks_report.h"

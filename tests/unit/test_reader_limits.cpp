@@ -15,8 +15,8 @@
 #include "pathbench/common/json_input.h"
 #include "pathbench/common/limits.h"
 #include "pathbench/common/scene_warnings.h"
-#include "scene_io/mitsuba.h"
-#include "scene_io/scene_io.h"
+#include "readers/mitsuba.h"
+#include "readers/readers.h"
 #include "scenes/builder.h"
 
 namespace pb {
@@ -53,7 +53,7 @@ std::string gltf(const std::string& accessor = "", const std::string& view = "",
 }
 
 Scene load_gltf(const std::string& text) {
-  return scene_io::parse_scene_gltf("t.gltf", text, false, memory_files());
+  return scene_io::parse_scene("t.gltf", text, memory_files());
 }
 
 TEST(GltfLimits, TheTriangleLoads) {
@@ -122,23 +122,23 @@ TEST(GltfLimits, GlbChunksMustLieInsideTheFile) {
   const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   std::memcpy(bin.data(), xyz, sizeof xyz);
   const FileReader none = memory_files();
-  EXPECT_NO_THROW(scene_io::parse_scene_gltf("t.glb", glb(glb_json(36), bin), true, none));
+  EXPECT_NO_THROW(scene_io::parse_scene("t.glb", glb(glb_json(36), bin), none));
   // tinygltf 2.7 takes a BIN chunk length up to the file's end as its data, 8 bytes
   // (the chunk header) too far: a buffer of that length was copied from past the end.
-  EXPECT_NE(error_of([&] { scene_io::parse_scene_gltf("t.glb", glb(glb_json(44), bin, 44), true, none); })
+  EXPECT_NE(error_of([&] { scene_io::parse_scene("t.glb", glb(glb_json(44), bin, 44), none); })
                 .find("t.glb: malformed GLB: the BIN chunk (44 bytes from byte"),
             std::string::npos);
   // A buffer of byteLength 0 from the BIN chunk: tinygltf's data.at(0) threw
   // std::out_of_range (exit 3).
-  EXPECT_NE(error_of([&] { scene_io::parse_scene_gltf("t.glb", glb(glb_json(0), bin), true, none); })
+  EXPECT_NE(error_of([&] { scene_io::parse_scene("t.glb", glb(glb_json(0), bin), none); })
                 .find("t.glb: malformed glTF:"),
             std::string::npos);
   // Deep JSON inside a GLB is scanned too.
   EXPECT_NE(error_of([&] {
-              scene_io::parse_scene_gltf("t.glb", glb(std::string(100, '[') + std::string(100, ']'), bin), true, none);
+              scene_io::parse_scene("t.glb", glb(std::string(100, '[') + std::string(100, ']'), bin), none);
             }).find("t.glb: JSON nested deeper than 64 levels"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { scene_io::parse_scene_gltf("t.glb", "glTF", true, none); }).find("t.glb: malformed GLB: 4 bytes"),
+  EXPECT_NE(error_of([&] { scene_io::parse_scene("t.glb", "glTF", none); }).find("t.glb: malformed GLB: 4 bytes"),
             std::string::npos);
 }
 
@@ -246,7 +246,7 @@ const char* const kSensor =
     R"(<sensor type="perspective"><transform name="to_world"><lookat origin="0,0,100" target="0,0,0"/></transform></sensor>)";
 
 Scene load_mitsuba(const std::string& body) {
-  return scene_io::parse_scene_mitsuba("t.xml", std::string("<scene version=\"3.0.0\">") + kSensor + body + "</scene>",
+  return scene_io::parse_scene("t.xml", std::string("<scene version=\"3.0.0\">") + kSensor + body + "</scene>",
                                        memory_files());
 }
 

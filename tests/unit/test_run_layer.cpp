@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
-#include "pathbench/run/prepared.h"
+#include "pathbench/run/built_scene.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/ranks.h"
 #include "pathbench/run/run.h"
 
@@ -103,14 +103,14 @@ TEST(RunRanks, ReducesFilmsExactlyAndChecksOverflow) {
   EXPECT_THROW(run::reduce_film(big, more), std::overflow_error);
 }
 
-// run::PreparedScene (prepared.h: the suite's benchmarks, issue 28): frames on a scene built once
+// run::BuiltScene (built_scene.h: the suite's benchmarks, issue 28): frames on a scene built once
 // are run::render's for the same settings (film bit for bit, rays, report fields), frame after
 // frame and for other frame settings it serves; settings that need another build are refused,
 // and bad settings before anything is built.
-TEST(PreparedScene, FramesAreRendersWithoutTheBuild) {
+TEST(BuiltScene, FramesAreRendersWithoutTheBuild) {
   const Scene scene = make_paper_cornell();
   const RenderSettings s = tiny();
-  const run::PreparedScene prepared(scene, s);
+  const run::BuiltScene prepared(scene, s);
   EXPECT_GE(prepared.build_seconds(), 0.0);
   const run::Rendered want = run::render(scene, s);
   Film film;
@@ -140,11 +140,11 @@ TEST(PreparedScene, FramesAreRendersWithoutTheBuild) {
   EXPECT_THROW(prepared.render(quads, film, r), std::logic_error);
 }
 
-TEST(PreparedScene, RefusesBadSettingsBeforeBuilding) {
+TEST(BuiltScene, RefusesBadSettingsBeforeBuilding) {
   const Scene scene = make_paper_cornell();
   RenderSettings s = tiny();
   s.spp = 0;
-  EXPECT_THROW(run::PreparedScene(scene, s), InputError);
+  EXPECT_THROW(run::BuiltScene(scene, s), InputError);
 }
 
 }  // namespace

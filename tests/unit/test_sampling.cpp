@@ -19,7 +19,7 @@
 #include "pathbench/common/path.h"
 #include "pathbench/common/rng.h"
 #include "pathbench/common/sampling.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "sphere_histogram.h"
 #include "stat_test.h"
 

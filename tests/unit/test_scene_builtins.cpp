@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 #include "test_scene_helpers.h"
 

@@ -2,7 +2,7 @@
 // image; an instanced scene renders bit-identically to the same scene flattened by hand.
 #include <gtest/gtest.h>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 
 namespace pb {

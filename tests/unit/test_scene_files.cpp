@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "test_scene_helpers.h"
 
 namespace pb {

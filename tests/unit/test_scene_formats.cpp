@@ -12,7 +12,7 @@
 
 #include "pathbench/common/errors.h"
 #include "test_scene_helpers.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 
 namespace pb {
 namespace {

@@ -11,10 +11,10 @@
 #include <functional>
 #include <unistd.h>
 
-#include "pathbench/common/data_dir.h"
+#include "pathbench/scene_io/data_dir.h"
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
-#include "scene_io/scene_io.h"
+#include "pathbench/scene_io/scene_library.h"
+#include "readers/readers.h"
 
 namespace pb {
 namespace {

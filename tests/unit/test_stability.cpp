@@ -14,7 +14,7 @@
 #include <random>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/cpu/embree_scene.h"
 #include "pathbench/run/run.h"
 #include "furnace_check.h"

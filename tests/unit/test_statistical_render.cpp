@@ -16,7 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "reference_test.h"
 
 namespace pb {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/run/run.h"
 
 namespace pb {

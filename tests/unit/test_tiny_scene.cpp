@@ -16,7 +16,7 @@
 
 #include "pathbench/common/camera.h"
 #include "pathbench/common/ray_offset.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/cpu/isa.h"
 #include "tiny_scene.h"
 

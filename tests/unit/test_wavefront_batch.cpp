@@ -15,7 +15,7 @@
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
-#include "pathbench/common/scene_library.h"
+#include "pathbench/scene_io/scene_library.h"
 #include "pathbench/cpu/isa.h"
 #include "pathbench/run/run.h"
 #include "shade_batch.h"
