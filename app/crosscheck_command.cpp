@@ -43,7 +43,8 @@ void add_crosscheck_options(CLI::App& cmd, CrosscheckOptions& o) {
   cmd.add_option("--threads", o.threads, "CPU threads (0: all)")->check(non_negative())->capture_default_str();
   cmd.add_flag("--strict", o.strict, "what the scene file holds that pathbench does not model is an error");
   cmd.footer("Exit status: 0 same up to noise, 1 different (a device's image fails the test), 2 bad input (a "
-             "message names it; nothing this run wrote is left in --out-dir), 3 an internal failure.");
+             "message names it; nothing this run wrote is left in --out-dir), 3 an internal failure; stopped by a signal "
+             "(Ctrl-C: 130, 128 + N), nothing this run wrote is left either.");
 }
 
 namespace {

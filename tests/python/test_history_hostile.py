@@ -388,7 +388,9 @@ def test_a_signal_mid_record_leaves_nothing_behind(tmp_path):
         err = proc.stderr.read()
         proc.stdout.close()
         proc.stderr.close()
-        assert rc in (0, 143) and "Traceback" not in err, err
+        # -15: the signal came before Python had started the tool (a loaded machine takes over
+        # 0.3 s to start it) and ended it by the default action, the shell's 143 too.
+        assert rc in (0, 143, -signal.SIGTERM) and "Traceback" not in err, err
         assert leftovers(tmp_path) == []
         stored = count(db) if db.exists() and rc == 0 else None
         if rc == 0:
