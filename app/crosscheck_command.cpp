@@ -205,12 +205,21 @@ int run_crosscheck(CrosscheckOptions& o) {
              terminal_safe(reference), mitsuba_spp);
   std::fflush(stdout);
   const int status = run_tool(args);
+  if (signals.signal()) {
+    // Even with a verdict: Mitsuba takes SIGINT itself, ends its render early ("winding
+    // down") and returns the partial image, which crosscheck.py then judged. Its files go too.
+    for (const Device dev : devices) {
+      out.file(fmt::format("diff-{}.pfm", to_string(dev)));
+      out.file(fmt::format("z-{}.pfm", to_string(dev)));
+    }
+    out.file("mitsuba.pfm");
+    out.file("verdict.json");
+    stop_if_signalled();
+  }
   if (status == 0 || status == 1) {  // a verdict: same or different
     out.keep();
-    if (signals.signal()) signals.stop();  // it came once the verdict was complete: kept, as render keeps its outputs
     return status;
   }
-  stop_if_signalled();
   if (status == kExitBadInput || status == kExitFailed) return status;  // its message is on stderr
   fmt::print(stderr, "pathbench: failed: crosscheck: tools/crosscheck.py ended with status {}\n", status);
   return kExitFailed;

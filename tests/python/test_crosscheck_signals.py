@@ -17,15 +17,25 @@ ROOT = Path(__file__).resolve().parents[2]
 PATHBENCH = ROOT / "build" / "bin" / "pathbench"
 
 FAKE = '''
-import os, time
+import os, signal, time
 import numpy as np
 class _Scene:
     def integrator(self): return "theirs"
 def set_variant(v): pass
 def load_file(path): return _Scene()
 def load_dict(d): return d
+_stopped = []
 def render(scene, integrator=None, spp=1, seed=0):
     open(os.environ["FAKE_MITSUBA_STARTED"], "w").close()
+    if os.environ.get("FAKE_MITSUBA_WINDS_DOWN"):
+        # As Mitsuba 3.9 does: its own SIGINT handler during render() ends the render early
+        # ("Received interrupt signal, winding down..") and returns the partial image.
+        old = signal.signal(signal.SIGINT, lambda *a: _stopped.append(1))
+        end = time.monotonic() + 120
+        while not _stopped and time.monotonic() < end:
+            time.sleep(0.01)
+        signal.signal(signal.SIGINT, old)
+        return np.full((8, 8, 3), 0.5, np.float32) + np.float32(seed) * 1e-3
     time.sleep(120)
     return np.ones((4, 4, 3), np.float32)
 '''
@@ -33,11 +43,12 @@ def render(scene, integrator=None, spp=1, seed=0):
 pytestmark = pytest.mark.skipif(not PATHBENCH.exists(), reason="needs build/bin/pathbench")
 
 
-def _start(tmp_path, out, *size):
+def _start(tmp_path, out, *size, **env_more):
     fake = tmp_path / "fake" / "mitsuba"
     fake.mkdir(parents=True)
     (fake / "__init__.py").write_text(FAKE)
-    env = dict(os.environ, PYTHONPATH=str(tmp_path / "fake"), FAKE_MITSUBA_STARTED=str(tmp_path / "started"))
+    env = dict(os.environ, PYTHONPATH=str(tmp_path / "fake"), FAKE_MITSUBA_STARTED=str(tmp_path / "started"),
+               **env_more)
     # A new session: the test's SIGINT to the group stands for the terminal's Ctrl-C.
     # Output to files, not pipes: a child left running would hold a pipe open.
     with open(tmp_path / "stdout", "w") as o, open(tmp_path / "stderr", "w") as e:
@@ -122,3 +133,13 @@ def test_ctrl_c_while_pathbench_renders_removes_the_exported_scene(tmp_path):
     _stopped(p, signal.SIGINT)
     assert not (tmp_path / "started").exists(), "the render had finished: make it larger"
     assert not out.exists(), sorted(str(q.relative_to(out)) for q in out.rglob("*"))
+
+
+def test_ctrl_c_that_mitsuba_takes_leaves_no_verdict_of_a_partial_render(tmp_path):
+    out = tmp_path / "out"
+    p = _start(tmp_path, out, "--width", "8", "--height", "8", "--spp", "4", FAKE_MITSUBA_WINDS_DOWN="1")
+    _wait_for(tmp_path / "started", p)
+    os.killpg(p.pid, signal.SIGINT)  # Mitsuba ends early, crosscheck.py judges what it got
+    _stopped(p, signal.SIGINT)
+    assert not out.exists(), sorted(str(q.relative_to(out)) for q in out.rglob("*"))
+
