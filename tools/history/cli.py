@@ -267,7 +267,9 @@ def _watch(done) -> None:
     from . import store
     while not done.is_set():
         info = signal.sigtimedwait(SIGNALS, 0.25)
-        if info is not None:
+        # CPython 3.11 returns a zeroed siginfo (si_signo 0), not None, when another signal
+        # interrupted the wait and the timeout ran out meanwhile: no signal of ours.
+        if info is not None and info.si_signo in SIGNALS:
             break
     else:
         return  # the run finished: this watcher ends with it
