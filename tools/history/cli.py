@@ -344,7 +344,8 @@ def main(argv: list[str] | None = None) -> int:
         return _err(f"needs the Python package providing '{e.name}' ({sys.executable}): "
                     "pip install -r tools/requirements.txt")
     except Stopped as e:
-        print(f"{PROG}: stopped by signal {e.signum}; nothing stored", file=sys.stderr)
+        done = "the runs were stored before it came" if getattr(e, "stored", False) else "nothing stored"
+        print(f"{PROG}: stopped by signal {e.signum}; {done}", file=sys.stderr)
         return 128 + e.signum
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted; nothing stored", file=sys.stderr)

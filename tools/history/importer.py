@@ -239,7 +239,10 @@ def insert_all(db, runs: list[dict], export_dir: str | None = None, skip_recorde
                     if not existed:
                         placed.append(final)
             db.execute("COMMIT")
-        except BaseException:
+        except BaseException as e:
+            if not db.in_transaction:  # a signal came after the COMMIT: stored, run files and all
+                e.stored = True
+                raise
             db.execute("ROLLBACK")
             for final in placed:
                 _remove(final)
