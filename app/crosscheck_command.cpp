@@ -3,8 +3,10 @@
 #include <fmt/core.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <future>
 #include <optional>
 #include <set>
 #include <utility>
@@ -41,7 +43,8 @@ void add_crosscheck_options(CLI::App& cmd, CrosscheckOptions& o) {
   cmd.add_option("--threads", o.threads, "CPU threads (0: all)")->check(non_negative())->capture_default_str();
   cmd.add_flag("--strict", o.strict, "what the scene file holds that pathbench does not model is an error");
   cmd.footer("Exit status: 0 same up to noise, 1 different (a device's image fails the test), 2 bad input (a "
-             "message names it; nothing this run wrote is left in --out-dir), 3 an internal failure.");
+             "message names it; nothing this run wrote is left in --out-dir), 3 an internal failure; stopped by a signal "
+             "(Ctrl-C: 130, 128 + N), nothing this run wrote is left either.");
 }
 
 namespace {
@@ -72,8 +75,11 @@ class OutDirRun {
   }
   OutDirRun(const OutDirRun&) = delete;
   OutDirRun& operator=(const OutDirRun&) = delete;
-  ~OutDirRun() {
+  ~OutDirRun() { discard(); }
+  // Removes what this run wrote (once; not after keep()).
+  void discard() {
     if (kept_) return;
+    kept_ = true;
     std::error_code ec;
     if (!created_.empty()) {
       fs::remove_all(created_, ec);
@@ -166,19 +172,32 @@ int run_crosscheck(CrosscheckOptions& o) {
     else if (o.device == "gpu") throw InputError("--device gpu: " + why);
     else fmt::print(stderr, "note: crosscheck: CPU only ({})\n", why);
   }
+  // From here a signal (Ctrl-C) must not end the process before what it wrote is removed
+  // (before, the images and the exported scene stayed): it is acted on at the checks below.
+  DeferredSignals signals;
   OutDirRun out(o.out_dir);
+  const auto stop_if_signalled = [&] {
+    if (!signals.signal()) return;
+    out.discard();
+    signals.stop();
+  };
   const std::string reference = !o.mitsuba_xml.empty() ? o.mitsuba_xml
                                 : own_xml             ? o.scene
                                                       : write_mitsuba_scene(scene, s, out.folder("mitsuba"));
+  stop_if_signalled();
   std::vector<std::string> args{"--xml", reference, "--out-dir", o.out_dir, "--spp", std::to_string(mitsuba_spp),
                                 "--pathbench-spp", std::to_string(o.spp), "--variant", o.variant, "--scene", o.scene,
                                 "--bounces", std::to_string(s.max_bounces)};
   for (Device dev : devices) {
     s.device = dev;
-    const run::Rendered r = run::render(scene, s);
+    // The render cannot be cancelled: it runs on another thread while this one watches.
+    auto rendering = std::async(std::launch::async, [&] { return run::render(scene, s); });
+    while (rendering.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready) stop_if_signalled();
+    const run::Rendered r = rendering.get();
     const std::string base = fmt::format("pathbench-{}", to_string(dev));
     write_image(out.file(base + ".pfm"), r.film.mean(), r.film.width(), r.film.height());
     write_image(out.file(base + "-var.pfm"), r.film.variance_of_mean(), r.film.width(), r.film.height());
+    stop_if_signalled();
     args.insert(args.end(), {"--image", fmt::format("{}={}", to_string(dev), (out.dir() / (base + ".pfm")).string())});
   }
   fmt::print("crosscheck: {} ({}x{}, {} spp, {} bounces) against Mitsuba 3 ({}, {} spp)\n", terminal_safe(o.scene),
@@ -186,6 +205,17 @@ int run_crosscheck(CrosscheckOptions& o) {
              terminal_safe(reference), mitsuba_spp);
   std::fflush(stdout);
   const int status = run_tool(args);
+  if (signals.signal()) {
+    // Even with a verdict: Mitsuba takes SIGINT itself, ends its render early ("winding
+    // down") and returns the partial image, which crosscheck.py then judged. Its files go too.
+    for (const Device dev : devices) {
+      out.file(fmt::format("diff-{}.pfm", to_string(dev)));
+      out.file(fmt::format("z-{}.pfm", to_string(dev)));
+    }
+    out.file("mitsuba.pfm");
+    out.file("verdict.json");
+    stop_if_signalled();
+  }
   if (status == 0 || status == 1) {  // a verdict: same or different
     out.keep();
     return status;

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "pathbench/common/errors.h"
+#include "pathbench/common/output_file.h"
 
 #ifndef PATHBENCH_SOURCE_DIR
 #define PATHBENCH_SOURCE_DIR ""
@@ -125,8 +126,10 @@ int run_python_tool(const PythonTool& tool, const std::vector<std::string>& args
   }
   close(pipefd[0]);
   int status = 0;
+  DeferredSignals::set_child(pid);  // a command that defers signals (crosscheck) passes them on
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  DeferredSignals::set_child(0);
   if (n == sizeof exec_errno) {
     if (!quiet_if_missing)
       fmt::print(stderr, "pathbench: error: {}: cannot run Python '{}': {} (set PATHBENCH_PYTHON to a Python 3)\n",

@@ -25,6 +25,7 @@
 #include <benchmark/benchmark.h>
 #include <fmt/core.h>
 
+#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -34,6 +35,8 @@
 
 #include "bench_context.h"
 #include "bench_ranks.h"
+#include "pathbench/common/display_text.h"
+#include "pathbench/common/errors.h"
 #include "pathbench/run/world.h"
 #if PATHBENCH_BENCH_GPU
 #include "pathbench/bvh/bvh_layout.h"
@@ -99,9 +102,21 @@ void preset_paper() {
 }
 
 // Largest scaling scene; 10^7 needs several GB and about a minute per build on 2 cores.
+// PATHBENCH_SCALING_MAX lowers it: a whole number in the scaling:N scenes' range, else
+// one line and exit 2 (strtoull took "abc" for 0, "-1" and 2^64-1 for a sweep that
+// never ends: n *= 10 wraps).
+constexpr uint64_t kScalingMin = 10, kScalingMax = 10000000;
 uint64_t scaling_max_triangles() {
-  if (const char* env = std::getenv("PATHBENCH_SCALING_MAX")) return std::strtoull(env, nullptr, 10);
-  return 10000000;
+  const char* env = std::getenv("PATHBENCH_SCALING_MAX");
+  if (!env) return kScalingMax;
+  const std::string text = env;
+  uint64_t n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || n < kScalingMin || n > kScalingMax)
+    throw InputError(fmt::format("PATHBENCH_SCALING_MAX='{}': expected a whole number of triangles from {} to {} "
+                                 "(the scaling:N scenes' range)",
+                                 terminal_safe(text), kScalingMin, kScalingMax));
+  return n;
 }
 
 void preset_scaling() {
@@ -183,7 +198,14 @@ int run_benchmarks(int argc, char** argv) {
   }
   if (preset == "quick") pb::bench::preset_quick();
   else if (preset == "paper") pb::bench::preset_paper();
-  else if (preset == "scaling") pb::bench::preset_scaling();
+  else if (preset == "scaling") {
+    try {
+      pb::bench::preset_scaling();
+    } catch (const pb::InputError& e) {
+      fmt::print(stderr, "pathbench-bench: {}\n", e.what());
+      return 2;
+    }
+  }
   else if (preset == "materials") pb::bench::preset_materials();
   else if (preset == "gpu-layouts") pb::bench::preset_gpu_layouts();
   else if (preset == "loading") pb::bench::preset_loading();

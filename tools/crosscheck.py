@@ -22,6 +22,7 @@ import json
 import math
 import os
 import re
+import signal
 import sys
 from pathlib import Path
 
@@ -159,8 +160,8 @@ def read_images(specs):
 
 
 def write_outputs(out_dir: Path, files: dict, verdict: dict) -> None:
-    """All of a run's files, or (on any failure) none of them: what this call created,
-    the folders included, is removed again before the error goes on."""
+    """All of a run's files, or (on any failure, a signal included) none of them: what
+    this call created, the folders included, is removed again before the error goes on."""
     created = [p for p in [out_dir, *out_dir.parents] if not p.exists()]
     written = []
     try:
@@ -172,7 +173,7 @@ def write_outputs(out_dir: Path, files: dict, verdict: dict) -> None:
         tmp = out_dir / "verdict.json.tmp"
         tmp.write_text(json.dumps(verdict, indent=2) + "\n")
         tmp.replace(out_dir / "verdict.json")
-    except OSError as e:
+    except BaseException as e:
         for p in written:
             for q in (p, p.with_name(p.name + ".tmp")):
                 q.unlink(missing_ok=True)
@@ -181,7 +182,9 @@ def write_outputs(out_dir: Path, files: dict, verdict: dict) -> None:
                 d.rmdir()
             except OSError:
                 pass
-        raise BadInput(f"--out-dir {out_dir}: {e.strerror or e}") from None
+        if isinstance(e, OSError):
+            raise BadInput(f"--out-dir {out_dir}: {e.strerror or e}") from None
+        raise
 
 
 def run(argv=None) -> int:
@@ -236,14 +239,43 @@ def run(argv=None) -> int:
     return 0 if ok else 1
 
 
+class Stopped(BaseException):
+    """SIGINT, SIGTERM or SIGHUP: the run stops, removing what it wrote; exit 128 + N."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def _stop(signum, _frame):
+    # The first signal stops the run; later ones (`pathbench crosscheck` passes a signal
+    # on, and the terminal may have sent it to both) must not interrupt the cleanup.
+    for s in STOP_SIGNALS:
+        signal.signal(s, signal.SIG_IGN)
+    raise Stopped(signum)
+
+
+def catch_stop_signals() -> None:
+    for s in STOP_SIGNALS:
+        if signal.getsignal(s) is not signal.SIG_IGN:  # one ignored by the parent (nohup) stays so
+            signal.signal(s, _stop)
+
+
 def main(argv=None) -> int:
     """Exit status: 0 every device passes, 1 one does not, 2 bad input (one line on
-    stderr, nothing written), 3 an internal failure (one line, no traceback)."""
+    stderr, nothing written), 3 an internal failure (one line, no traceback), 128 + N
+    stopped by signal N (nothing written)."""
     try:
+        catch_stop_signals()
         return run(argv)
     except BadInput as e:
         print(f"crosscheck.py: error: {shown(e)}", file=sys.stderr)
         return 2
+    except Stopped as e:
+        return 128 + e.signum
     except KeyboardInterrupt:
         return 130
     except Exception as e:  # noqa: BLE001 (a bug here: said in one line, never taken for "different")

@@ -127,6 +127,8 @@ void Scene::finalize() {
       in.triangle_count = kept_before[end] - in.first_triangle;
     }
   }
+  instanced_triangle_count = 0;  // also right for instances a caller pushed itself
+  for (const SceneInstance& in : instances) instanced_triangle_count += in.triangle_count;
   if (dropped_triangles)
     scene_warning(fmt::format("{}: dropped {} zero-area triangle{}", name, dropped_triangles,
                               dropped_triangles == 1 ? "" : "s"));

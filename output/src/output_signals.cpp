@@ -58,25 +58,65 @@ const char* signal_name(int sig) {
   return "a signal";
 }
 
+bool remove_temp_files() {
+  bool removed = false;
+  for (Slot& s : g_slots)
+    if (s.used.load(std::memory_order_acquire)) removed |= ::unlink(s.path) == 0;
+  return removed;
+}
+
+void say_stopped(int sig, const char* tail) {
+  const char* name = signal_name(sig);
+  ssize_t ignored = ::write(STDERR_FILENO, "\npathbench: ", 12);
+  ignored = ::write(STDERR_FILENO, name, std::strlen(name));
+  ignored = ::write(STDERR_FILENO, tail, std::strlen(tail));
+  (void)ignored;
+}
+
 void on_fatal_signal(int sig) {
   const int saved = errno;
   g_stopping.store(true);
   wait_for_open_sections();
   const pid_t child = g_child.load(std::memory_order_acquire);
   if (child > 0) ::kill(child, sig);
-  bool removed = false;
-  for (Slot& s : g_slots)
-    if (s.used.load(std::memory_order_acquire)) removed |= ::unlink(s.path) == 0;
-  const char* name = signal_name(sig);
-  const char* tail = removed ? ": stopped; temporary output files removed\n" : ": stopped\n";
-  ssize_t ignored = ::write(STDERR_FILENO, "\npathbench: ", 12);
-  ignored = ::write(STDERR_FILENO, name, std::strlen(name));
-  ignored = ::write(STDERR_FILENO, tail, std::strlen(tail));
-  (void)ignored;
+  say_stopped(sig, remove_temp_files() ? ": stopped; temporary output files removed\n" : ": stopped\n");
   errno = saved;
   // SA_RESETHAND restored the default action; the signal is blocked while this
   // handler runs, so it is delivered (and ends the process) as the handler returns.
   ::raise(sig);
+}
+
+// DeferredSignals: the first signal is recorded for the owner to act on and passed to
+// the child unless the terminal sent it (then the child's process group has it too:
+// a second copy would interrupt the child's own cleanup); a second one kills the
+// child, so an unresponsive child cannot keep the owner from stopping.
+std::atomic<bool> g_deferred{false};
+std::atomic<int> g_pending{0};
+std::atomic<pid_t> g_deferred_child{0};
+
+void install_handler(int sig);
+
+void on_signal(int sig, siginfo_t* info, void*) {
+  if (!g_deferred.load()) return on_fatal_signal(sig);
+  const int saved = errno;
+  const pid_t child = g_deferred_child.load(std::memory_order_acquire);
+  int expected = 0;
+  if (g_pending.compare_exchange_strong(expected, sig)) {
+    if (child > 0 && !(info && info->si_code == SI_KERNEL)) ::kill(child, sig);
+  } else if (child > 0) {
+    ::kill(child, SIGKILL);
+  }
+  install_handler(sig);  // SA_RESETHAND restored the default action
+  errno = saved;
+}
+
+void install_handler(int sig) {
+  struct sigaction sa {};
+  sa.sa_sigaction = on_signal;
+  sigemptyset(&sa.sa_mask);
+  for (int other : kCleanupSignals) sigaddset(&sa.sa_mask, other);  // one cleanup at a time
+  sa.sa_flags = SA_RESETHAND | SA_SIGINFO;
+  ::sigaction(sig, &sa, nullptr);
 }
 
 }  // namespace
@@ -126,15 +166,43 @@ void install_output_signal_cleanup() {
   for (int sig : detail::kCleanupSignals) {
     struct sigaction old {};
     if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;  // e.g. nohup, `cmd &`
-    struct sigaction sa {};
-    sa.sa_handler = detail::on_fatal_signal;
-    sigemptyset(&sa.sa_mask);
-    for (int other : detail::kCleanupSignals) sigaddset(&sa.sa_mask, other);  // one cleanup at a time
-    sa.sa_flags = SA_RESETHAND;
-    ::sigaction(sig, &sa, nullptr);
+    detail::install_handler(sig);
   }
 }
 
 void forward_signals_to(pid_t child) { detail::g_child.store(child, std::memory_order_release); }
+
+DeferredSignals::DeferredSignals() {
+  detail::g_pending.store(0);
+  detail::g_deferred.store(true);
+}
+
+DeferredSignals::~DeferredSignals() {
+  detail::g_deferred.store(false);
+  detail::g_deferred_child.store(0);
+  // A signal recorded and never acted on still ends the process, as it would have.
+  if (const int sig = detail::g_pending.exchange(0)) ::raise(sig);
+}
+
+int DeferredSignals::signal() const { return detail::g_pending.load(); }
+
+void DeferredSignals::set_child(pid_t child) { detail::g_deferred_child.store(child, std::memory_order_release); }
+
+void DeferredSignals::stop() const {
+  const int sig = detail::g_pending.load();
+  detail::g_deferred.store(false);
+  detail::remove_temp_files();
+  detail::say_stopped(sig, ": stopped; the files this run wrote are removed\n");
+  struct sigaction sa {};
+  sa.sa_handler = SIG_DFL;
+  sigemptyset(&sa.sa_mask);
+  ::sigaction(sig, &sa, nullptr);
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, sig);
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+  ::raise(sig);
+  ::_exit(128 + sig);  // not reached: the default action ends the process
+}
 
 }  // namespace pb

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from history import changes, export, importer, store, synthetic
+from history import changes, runfile, store, synthetic
 
 ROOT = Path(__file__).resolve().parents[2]
 QUICK = ROOT / "tests" / "data" / "bench" / "quick-9rep.json"
@@ -100,8 +100,8 @@ def test_text_export_rebuilds_the_same_database(tmp_path):
         "ORDER BY 1, 2, 3"
     assert rows(db, q) == rows(tmp_path / "again.sqlite", q) and len(rows(db, q)) == 3 * 144
     # The export is stable: writing a run again gives the same bytes.
-    run = export.read_run(str(files[0]))
-    again = export.write_run(str(tmp_path / "copy"), run)
+    run = runfile.read_run(str(files[0]))
+    again = runfile.write_run(str(tmp_path / "copy"), run)
     assert Path(again).read_bytes() == files[0].read_bytes()
 
 

@@ -388,13 +388,17 @@ def test_a_signal_mid_record_leaves_nothing_behind(tmp_path):
         err = proc.stderr.read()
         proc.stdout.close()
         proc.stderr.close()
-        assert rc in (0, 143) and "Traceback" not in err, err
+        # -15: the signal came before Python had started the tool (a loaded machine takes over
+        # 0.3 s to start it) and ended it by the default action, the shell's 143 too.
+        assert rc in (0, 143, -signal.SIGTERM) and "Traceback" not in err, err
         assert leftovers(tmp_path) == []
-        stored = count(db) if db.exists() and rc == 0 else None
-        if rc == 0:
-            assert stored == 1 and len(list(ex.glob("*.jsonl"))) == 1
+        stored = count(db) if db.exists() else 0
+        files = len(list(ex.glob("*.jsonl"))) if ex.exists() else 0
+        if rc == 0 or stored:  # 143 with the run stored: the signal came after the COMMIT
+            assert (stored, files) == (1, 1), err
+            assert rc == 0 or "stored before it came" in err, err
             break
-        assert not ex.exists() or list(ex.glob("*.jsonl")) == []
+        assert files == 0, err  # all or nothing (before: "cannot rollback - no transaction is active", exit 2)
 
 
 # ---- git ---------------------------------------------------------------------------------------------
@@ -676,3 +680,53 @@ def test_a_missing_tool_package_is_named_in_one_line(tmp_path):
             f"sys.exit(cli.main(['changes', '--otava-only', '--db', {str(db)!r}]))\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=os.environ | {"PYTHONPATH": TOOLS})
     assert "otava" in one_line_error(r) and "requirements.txt" in r.stderr
+
+
+def test_the_signal_watcher_takes_only_its_signals(monkeypatch):
+    """CPython 3.11's sigtimedwait returns a zeroed siginfo (si_signo 0), not None, when another
+    signal interrupted the wait and its timeout ran out: the watcher took that for a signal and
+    died with a traceback (ValueError: signal number out of range; 3 of 90 `history record`
+    runs under load). It must go on waiting, and leave the main thread alone."""
+    import threading
+    import types
+    sys.path.insert(0, TOOLS)
+    from history import cli
+    done, waits = threading.Event(), []
+
+    def sigtimedwait(signals, timeout):
+        waits.append(timeout)
+        if len(waits) == 3:
+            done.set()
+        return types.SimpleNamespace(si_signo=0)
+
+    monkeypatch.setattr(cli.signal, "sigtimedwait", sigtimedwait)
+    cli._watch(done)  # returns once the run is done, without interrupting it
+    assert len(waits) == 3
+
+
+def test_a_signal_right_after_the_commit_keeps_the_run_whole(tmp_path):
+    """The watcher's Stopped can land between COMMIT and the end of insert_all: ROLLBACK then
+    failed ("cannot rollback - no transaction is active", exit 2) and the run files of a stored
+    run were removed. Now the run stays whole, and the message says it was stored."""
+    sys.path.insert(0, TOOLS)
+    from history import cli, importer, store
+    run = importer.parse(str(QUICK))
+    real = store.connect(str(tmp_path / "h.sqlite"))
+
+    class SignalAfterCommit:
+        in_transaction = property(lambda self: real.in_transaction)
+
+        def execute(self, sql, *args):
+            out = real.execute(sql, *args)
+            if sql == "COMMIT":
+                raise cli.Stopped(signal.SIGTERM)
+            return out
+
+        def executemany(self, sql, rows):
+            return real.executemany(sql, rows)
+
+    with pytest.raises(cli.Stopped) as e:
+        importer.insert_all(SignalAfterCommit(), [run], export_dir=str(tmp_path / "runs"))
+    real.close()
+    assert getattr(e.value, "stored", False)
+    assert count(tmp_path / "h.sqlite") == 1 and len(list((tmp_path / "runs").glob("*.jsonl"))) == 1

@@ -307,5 +307,46 @@ TEST(MitsubaLimits, DefaultSubstitutionIsBounded) {
       << e;
 }
 
+
+// The triangles instances expanded into are counted as they are placed (Scene's
+// running count): appending a flat mesh summed every instance before, quadratic when
+// flat meshes and placements alternate (Mitsuba shapes beside instances, glTF nodes).
+// The count follows finalize() dropping zero-area triangles of an instance.
+TEST(PlacementLimits, InstancedTriangleCountIsKeptWhilePlacing) {
+  Scene s;
+  s.name = "t.json";
+  const scene_io::MeshData quad = scene_io::mitsuba::rectangle_mesh();
+  const uint32_t proto = scene_io::add_prototype(s, "quad", quad, {0});
+  constexpr int kPlacements = 60000;
+  const double t = seconds_of([&] {
+    for (int i = 0; i < kPlacements; ++i) {
+      scene_io::add_instance(s, proto, Affine::translate(0, i, 0));
+      scene_io::append_mesh(s, quad, Affine::translate(3, i, 0), {0});
+    }
+  });
+  uint64_t sum = 0;
+  for (const SceneInstance& in : s.instances) sum += in.triangle_count;
+  EXPECT_EQ(sum, 2u * kPlacements);
+  EXPECT_EQ(scene_io::instanced_triangles(s), sum);
+  EXPECT_EQ(s.triangles.size(), 4u * kPlacements);
+  EXPECT_LT(t, 3.0);  // ~0.05 s; summing every instance per flat mesh: ~20 s here
+
+  Scene d;  // a prototype with a zero-area triangle, placed twice, beside a flat light
+  d.name = "d.json";
+  d.materials = {Material{{0.5f, 0.5f, 0.5f}, {0, 0, 0}}, Material{{0, 0, 0}, {1, 1, 1}}};
+  scene_io::MeshData half = quad;
+  half.triangles.push_back({{0, 0, 1}});
+  const uint32_t p = scene_io::add_prototype(d, "half", half, {0});
+  scene_io::add_instance(d, p, Affine());
+  scene_io::add_instance(d, p, Affine::translate(0, 0, -1));
+  scene_io::append_mesh(d, quad, Affine::translate(0, 0, 2), {1});
+  EXPECT_EQ(scene_io::instanced_triangles(d), 6u);
+  d.camera = Camera::look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 50);
+  SceneWarningCollector quiet;
+  d.finalize();
+  EXPECT_EQ(d.dropped_triangles, 2u);
+  EXPECT_EQ(scene_io::instanced_triangles(d), 4u);
+}
+
 }  // namespace
 }  // namespace pb

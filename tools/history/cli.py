@@ -267,7 +267,9 @@ def _watch(done) -> None:
     from . import store
     while not done.is_set():
         info = signal.sigtimedwait(SIGNALS, 0.25)
-        if info is not None:
+        # CPython 3.11 returns a zeroed siginfo (si_signo 0), not None, when another signal
+        # interrupted the wait and the timeout ran out meanwhile: no signal of ours.
+        if info is not None and info.si_signo in SIGNALS:
             break
     else:
         return  # the run finished: this watcher ends with it
@@ -342,7 +344,8 @@ def main(argv: list[str] | None = None) -> int:
         return _err(f"needs the Python package providing '{e.name}' ({sys.executable}): "
                     "pip install -r tools/requirements.txt")
     except Stopped as e:
-        print(f"{PROG}: stopped by signal {e.signum}; nothing stored", file=sys.stderr)
+        done = "the runs were stored before it came" if getattr(e, "stored", False) else "nothing stored"
+        print(f"{PROG}: stopped by signal {e.signum}; {done}", file=sys.stderr)
         return 128 + e.signum
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted; nothing stored", file=sys.stderr)

@@ -51,11 +51,7 @@ MeshData read_mesh_file(const std::string& path, bool with_materials, const File
   return read_obj_mesh(path, text, with_materials, read, losses);
 }
 
-uint64_t instanced_triangles(const Scene& s) {
-  uint64_t n = 0;
-  for (const SceneInstance& in : s.instances) n += in.triangle_count;
-  return n;
-}
+uint64_t instanced_triangles(const Scene& s) { return s.instanced_triangle_count; }
 
 namespace {
 
@@ -128,6 +124,7 @@ void add_instance(Scene& s, uint32_t prototype, const Affine& to_world, bool fli
   // The prototype's own arrays, not a copy per placement.
   const uint32_t first = append_geometry(s, p.positions, p.triangles, to_world, p.material_ids, flip_winding, true);
   s.instances.push_back({prototype, to_world, first, uint32_t(p.triangles.size())});
+  s.instanced_triangle_count += p.triangles.size();
 }
 
 namespace {

@@ -36,9 +36,9 @@ except ImportError:  # --replay and --mutate work without it
 
 if atheris is not None and "--replay" not in sys.argv and "--mutate" not in sys.argv:
     with atheris.instrument_imports(include=["history"]):
-        from history import changes, export, importer, report, store, text
+        from history import changes, importer, report, runfile, store, text
 else:
-    from history import changes, export, importer, report, store, text
+    from history import changes, importer, report, runfile, store, text
 
 # git is not part of what is fuzzed (tests/python/test_history_hostile.py covers its arguments),
 # and a process per input would make the fuzzer a hundred times slower.
@@ -62,7 +62,7 @@ def one_input(data: bytes) -> None:
     with open(path, "wb") as f:
         f.write(data[1:] if data[:1] == b"r" else data)
     try:
-        run = export.read_run(path) if data[:1] == b"r" else importer.parse(path)
+        run = runfile.read_run(path) if data[:1] == b"r" else importer.parse(path)
     except store.UserError:
         return  # a clean refusal: exit 2 with one line
     # Past this point the run was accepted: every later refusal is a finding too (a run the
@@ -88,10 +88,10 @@ def follow(run: dict, data: bytes) -> None:
             if not importer.recorded(db, more["run_key"]):
                 importer.insert_all(db, [more])
         # The run file reads back as the same run.
-        written = os.path.join(TMP, "runs", export.file_name(run))
-        back = export.read_run(written)
+        written = os.path.join(TMP, "runs", runfile.file_name(run))
+        back = runfile.read_run(written)
         os.remove(written)
-        for k in export.HEADER_KEYS:
+        for k in runfile.HEADER_KEYS:
             if back.get(k) != run.get(k) and not (k == "source" and not run.get(k)):
                 raise Finding(f"run file round trip changed {k}: {run.get(k)!r:.100} -> {back.get(k)!r:.100}")
         if sorted(back["results"], key=_key) != sorted(run["results"], key=_key):

@@ -98,6 +98,10 @@ struct Scene {
   Camera camera{};
   std::vector<ScenePrototype> prototypes;
   std::vector<SceneInstance> instances;
+  // The sum of the instances' triangle_count, kept as they are placed (scene_io::add_instance)
+  // and by finalize(): the readers check the flat-triangle limit on every mesh they append,
+  // and summing the instances each time made loading quadratic.
+  uint64_t instanced_triangle_count = 0;
   SceneRenderDefaults render_defaults;
 
   // Derived by finalize().

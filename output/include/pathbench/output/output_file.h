@@ -78,4 +78,22 @@ void install_output_signal_cleanup();
 // pathbench-bench as a child); 0 for none.
 void forward_signals_to(pid_t child);
 
+// For a command that must remove finished files of its own on such a signal (crosscheck:
+// its images and exported scene): while one lives, the signal does not end the process
+// at once. It is recorded (signal()) and passed on to the child set_child() names, unless
+// the terminal sent it to the whole process group; a second signal kills that child. The
+// owner looks at signal() at its safe points, removes what it wrote and calls stop(),
+// which ends the process by that signal (the shell's status: 128 + its number). A
+// signal still recorded when it is destroyed ends the process then. One at a time.
+class DeferredSignals {
+ public:
+  DeferredSignals();
+  ~DeferredSignals();
+  DeferredSignals(const DeferredSignals&) = delete;
+  DeferredSignals& operator=(const DeferredSignals&) = delete;
+  int signal() const;  // the signal recorded, 0 for none
+  static void set_child(pid_t child);  // 0 for none
+  [[noreturn]] void stop() const;
+};
+
 }  // namespace pb
