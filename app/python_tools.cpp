@@ -11,7 +11,7 @@
 #include <filesystem>
 
 #include "pathbench/common/errors.h"
-#include "pathbench/common/output_file.h"
+#include "pathbench/output/output_file.h"
 
 #ifndef PATHBENCH_SOURCE_DIR
 #define PATHBENCH_SOURCE_DIR ""

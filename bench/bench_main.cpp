@@ -148,7 +148,7 @@ void preset_scaling() {
 
 void preset_gpu_layouts() {
 #if PATHBENCH_BENCH_GPU
-  using gpu::GpuBvhLayout;
+  using bvh::GpuBvhLayout;
   for (const char* scene : {"paper-cornell", "paper-cornell-ico:0", "paper-cornell-ico:1", "paper-cornell-ico:2",
                             "paper-cornell-ico:8"})
     register_gpu_raycast_benchmarks({scene, 256, 256}, {GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,

@@ -11,6 +11,7 @@
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/traversal.h"
 #include "pathbench/gpu/render.h"
+#include "bvh_names.h"
 
 namespace pb::gpu {
 

@@ -16,6 +16,7 @@
 #include "pathbench/common/errors.h"
 #include "strategies.cuh"
 #include "work_chunks.cuh"
+#include "bvh_names.h"
 
 namespace pb::gpu {
 

@@ -29,6 +29,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "strategies.cuh"
+#include "bvh_names.h"
 
 #ifndef PATHBENCH_CUDA_ARCHS
 #define PATHBENCH_CUDA_ARCHS "?"

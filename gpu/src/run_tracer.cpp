@@ -6,6 +6,7 @@
 #include "pathbench/gpu/device_facts.h"
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/tracer.h"
+#include "bvh_names.h"
 
 namespace pb::gpu {
 

@@ -6,6 +6,7 @@
 #include "device_facts.h"
 #include "gpu_scene_impl.cuh"
 #include "pathbench/bvh/bvh_layout.h"
+#include "bvh_names.h"
 
 namespace pb::gpu {
 

@@ -12,6 +12,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/bvh/traversal.h"
 #include "pathbench/gpu/render.h"
+#include "bvh_names.h"
 
 namespace pb::gpu {
 

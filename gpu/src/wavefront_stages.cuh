@@ -13,6 +13,7 @@
 #include "pathbench/bvh/traversal.h"
 #include "wavefront_state.cuh"
 #include "work_chunks.cuh"
+#include "bvh_names.h"
 
 namespace pb::gpu {
 namespace {

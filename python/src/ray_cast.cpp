@@ -83,7 +83,7 @@ void intersect(const SceneHandle& scene, const RayBatch& rays, Backend backend, 
                uint32_t* prim, float* t) {
   validate(rays, backend, watertight);
   auto store = [&](size_t i, uint32_t p, float tt) {
-    hit[i] = p != gpu::kNoHit;
+    hit[i] = p != bvh::kNoHit;
     prim[i] = p;
     t[i] = hit[i] ? tt : kInf;
   };
@@ -98,13 +98,13 @@ void intersect(const SceneHandle& scene, const RayBatch& rays, Backend backend, 
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(s, &ctx, &rh);
-      store(i, rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? gpu::kNoHit : embree.triangle(rh.hit), rh.ray.tfar);
+      store(i, rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? bvh::kNoHit : embree.triangle(rh.hit), rh.ray.tfar);
     });
   } else {
-    const gpu::BvhView view = scene.bvh().view();
+    const bvh::BvhView view = scene.bvh().view();
     parallel_rays(rays.n, [&](size_t i) {
       float tt = kInf;
-      const uint32_t p = gpu::intersect_closest(view, row(rays.origins, i), row(rays.directions, i), rays.tfar_at(i), tt);
+      const uint32_t p = bvh::intersect_closest(view, row(rays.origins, i), row(rays.directions, i), rays.tfar_at(i), tt);
       store(i, p, tt);
     });
   }
@@ -123,9 +123,9 @@ void occluded(const SceneHandle& scene, const RayBatch& rays, Backend backend, b
       out[i] = ray.tfar < 0.0f;  // Embree marks an occluded ray with tfar = -inf
     });
   } else {
-    const gpu::BvhView view = scene.bvh().view();
+    const bvh::BvhView view = scene.bvh().view();
     parallel_rays(rays.n, [&](size_t i) {
-      out[i] = gpu::occluded(view, row(rays.origins, i), row(rays.directions, i), rays.tfar_at(i));
+      out[i] = bvh::occluded(view, row(rays.origins, i), row(rays.directions, i), rays.tfar_at(i));
     });
   }
 }

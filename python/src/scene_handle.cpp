@@ -9,9 +9,9 @@ const cpu::EmbreeScene& SceneHandle::embree(bool watertight) const {
   return *e;
 }
 
-const gpu::BvhHost& SceneHandle::bvh() const {
+const bvh::BvhHost& SceneHandle::bvh() const {
   std::lock_guard lock(mutex_);
-  if (!bvh_) bvh_ = std::make_unique<gpu::BvhHost>(gpu::build_bvh(scene_));
+  if (!bvh_) bvh_ = std::make_unique<bvh::BvhHost>(bvh::build_bvh(scene_));
   return *bvh_;
 }
 

@@ -22,14 +22,14 @@ class SceneHandle {
   // The CPU tracer's Embree scene (make_embree_scene(scene, watertight, layout)), built once per flag.
   const cpu::EmbreeScene& embree(bool watertight) const;
   // The GPU tracer's BVH (build_bvh with its default options), kept on the host.
-  const gpu::BvhHost& bvh() const;
+  const bvh::BvhHost& bvh() const;
 
  private:
   Scene scene_;
   EmbreeLayout layout_;
   mutable std::mutex mutex_;
   mutable std::unique_ptr<cpu::EmbreeScene> embree_[2];  // [watertight]
-  mutable std::unique_ptr<gpu::BvhHost> bvh_;
+  mutable std::unique_ptr<bvh::BvhHost> bvh_;
 };
 
 }  // namespace pb::python

@@ -24,6 +24,7 @@
 #endif
 
 namespace pb::gpu {
+using namespace pb::bvh;  // the BVH library (bvh/) the tracer under test uses
 namespace {
 
 #define PB_REQUIRE_GPU()                                        \

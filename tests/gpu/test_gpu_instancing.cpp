@@ -15,6 +15,7 @@
 #include "pathbench/gpu/render.h"
 
 namespace pb::gpu {
+using namespace pb::bvh;  // the BVH library (bvh/) the tracer under test uses
 namespace {
 
 const std::string kRoot = std::string(PATHBENCH_SOURCE_DIR) + "/";

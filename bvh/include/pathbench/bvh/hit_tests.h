@@ -7,7 +7,6 @@
 // host-side tests run the same functions.
 #include <cstdint>
 
-#include "pathbench/bvh/gpu_names.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
 #include "pathbench/common/moller_trumbore.h"
