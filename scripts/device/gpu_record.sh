@@ -6,7 +6,8 @@
 # BASE_PATCH on a copy of this tree, and the roofline (scripts/device/gpu_roofline.sh) if time is
 # left. Everything goes to OUT_DIR; console output says what passed.
 #   scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]
-# BASE_PATCH: `git diff BASE -- gpu/ bvh/ common/` made on the development host; CASES_FILE: the
+# BASE_PATCH: `git diff BASE -- gpu/ bvh/ common/` made on the development host, or a whole base
+# tree `git archive BASE | xz > base.tar.xz` (where the change moved files); CASES_FILE: the
 # A/B's cases (scripts/device/gpu_ab.sh's format), else its defaults. Needs .gpu-deps (see
 # ../shared/gpu-host/README.md); PATHBENCH_SOURCE_COMMIT names the commit in the reports
 # (from .gpu-deps/source-commit when set there).
@@ -31,8 +32,13 @@ echo "source commit ${PATHBENCH_SOURCE_COMMIT:-unknown}"
 nvidia-smi --query-gpu=name,driver_version,temperature.gpu,clocks.sm,clocks.max.sm,clocks_event_reasons.active \
   --format=csv > "$out/gpu-state-start.csv" 2>&1
 base=/tmp/pathbench-base
-rm -rf $base && mkdir -p $base && tar --exclude=./build-gpu --exclude=./build --exclude=./.git -cf - . | tar -xf - -C $base
-(cd $base && patch -s -R -p1 < "$patch_file") || { echo "the base patch does not reverse on this tree"; exit 1; }
+rm -rf $base && mkdir -p $base
+if [[ $patch_file == *.tar.xz ]]; then  # a whole base tree (`git archive BASE | xz`): where files moved
+  tar -xJf "$patch_file" -C $base || { echo "the base tree $patch_file does not unpack"; exit 1; }
+else
+  tar --exclude=./build-gpu --exclude=./build --exclude=./.git -cf - . | tar -xf - -C $base
+  (cd $base && patch -s -R -p1 < "$patch_file") || { echo "the base patch does not reverse on this tree"; exit 1; }
+fi
 (cmake -S $base -B $base/build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF \
    -DCMAKE_CUDA_ARCHITECTURES=90 > /dev/null 2>&1 && cmake --build $base/build-gpu -j 5 --target pathbench \
    > "$out/base-build.log" 2>&1; echo "base build rc=$?") &
