@@ -204,10 +204,12 @@ def test_render_report_energy_null_with_reason_and_rapl_wrap(tmp_path):
     os.mkfifo(fake / "energy_uj")
 
     def feed():  # one value per open; the pause lets the reader close before the next one
+        # (1.5 s: with 0.3 s a loaded 2-core machine had not closed the last read before the
+        # next open, so two values went to one reader and the figure came out near 1 J)
         for v in ("999990", "999990", "10"):
             with open(fake / "energy_uj", "w") as f:
                 f.write(v + "\n")
-            time.sleep(0.3)
+            time.sleep(1.5)
     t = threading.Thread(target=feed, daemon=True)
     t.start()
     r = subprocess.run(base, capture_output=True, text=True, env=env, timeout=60)
