@@ -5,7 +5,8 @@
 // wavefront_state.cuh / wavefront_stages.cuh / path_pool.cu (wavefront, paper-queue),
 // scene_upload.cu, device_facts.cu, trace.cu (traversal alone), cuda_util (launches).
 // What a render sets up the same way every time (stream, events, launcher, counters, the
-// device's facts; a kept film's pools) is kept for the process's next render: RenderCache.
+// device's facts; a kept film's pools) is kept for the process's next render: RenderCache
+// (render_cache.cuh).
 #include "pathbench/gpu/render.h"
 
 #include <cuda_runtime.h>
@@ -16,7 +17,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -26,6 +26,7 @@
 #include "device_film.cuh"
 #include "gpu_scene_impl.cuh"
 #include "path_pool.cuh"
+#include "render_cache.cuh"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "strategies.cuh"
@@ -66,7 +67,6 @@ double download_film(const FilmBuffers& fb, Film& film) {
 
 void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,
                  RunReport& report, bool profile, DeviceFilm* keep);
-bool render_cache_enabled();  // PATHBENCH_GPU_RENDER_CACHE (below)
 }  // namespace
 
 double DeviceFilm::download(Film& film) const {
@@ -107,69 +107,6 @@ void render(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings&
 }
 
 namespace {
-// What gpu::render keeps across the calls of a process (issue 30: the hybrid's GPU rank paid
-// ~0.37 ms a call for it, outside the timed frame, and a one-GPU process none): the
-// device's facts (cudaGetDeviceProperties, the driver's version file), the render's stream
-// and timing events, the launcher (its stages' occupancy queries), the pixel strategy's
-// counter block, and, for a kept film (an MPI rank's chunks), the wavefront's pools while
-// the next chunk asks for pools of the same sizes. One device a cache (an MPI rank's): a
-// render on another device, one while another thread renders, or any render with
-// PATHBENCH_GPU_RENDER_CACHE=0 makes its own, as before. Never destroyed (CUDA may be torn
-// down first at exit, as DeviceMemory's ledger says).
-struct RenderCache {
-  explicit RenderCache(int d) : device(d), info(device_info()), driver(kernel_driver_version()), launch(stream.s, false) {}
-  const int device;
-  const DeviceInfo info;
-  const std::string driver;
-  ScopedStream stream;
-  ScopedEvent ev0, ev1;
-  Launcher launch;  // not profiling: a profiled render's launcher records events of its own
-  DeviceBuffer<PixelCounters> pixel_counters;
-  // A kept film's wavefront pools, their sizes and shadow records.
-  std::vector<std::unique_ptr<PathPool>> pools;
-  std::vector<std::unique_ptr<ScopedStream>> pool_streams;
-  std::vector<uint64_t> pool_caps;
-  ShadowUse pool_shadows;
-  // default_paths_in_flight's last answer (it reads the device's properties) and its question.
-  uint64_t pif_bytes_per_path = 0, pif_bytes_in_use = 0, pif = 0;
-  // Any render that does not use the kept pools releases them: no device memory is held
-  // beside a render (or in its measurement) for pools it does not run.
-  void drop_pools() {
-    pools.clear();
-    pool_streams.clear();
-    pool_caps.clear();
-  }
-};
-
-bool render_cache_enabled() {
-  static const bool on = [] {
-    const char* v = std::getenv("PATHBENCH_GPU_RENDER_CACHE");
-    const std::string s = v ? v : "";
-    if (s.empty() || s == "1" || s == "on") return true;
-    if (s == "0" || s == "off") return false;
-    throw InputError(fmt::format("PATHBENCH_GPU_RENDER_CACHE='{}': expected 1, on, 0 or off", s));
-  }();
-  return on;
-}
-
-std::mutex render_cache_mutex;
-RenderCache* render_cache = nullptr;  // guarded by render_cache_mutex
-
-// The cache for one render, held (locked) while the render lives; null where it cannot serve.
-struct CacheLease {
-  std::unique_lock<std::mutex> lock{render_cache_mutex, std::defer_lock};
-  RenderCache* cache = nullptr;
-  CacheLease() {
-    if (!render_cache_enabled() || !lock.try_lock()) return;
-    ensure_device();  // no device: its InputError, as without the cache
-    int device = 0;
-    PB_CUDA_CHECK(cudaGetDevice(&device));
-    if (!render_cache) render_cache = new RenderCache(device);
-    if (render_cache->device == device) cache = render_cache;
-    else lock.unlock();
-  }
-};
-
 // 1. Setup: the film on the device (this render's own, or a kept one that earlier renders,
 // an MPI rank's chunks, added into, allocated and warmed up by the first of them), and the
 // strategy's resources sized for the render's samples. The run layer has checked the

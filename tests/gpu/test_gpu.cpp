@@ -269,7 +269,7 @@ TEST(DeviceFilm, BlocksAddUpToTheWholeFrame) {
   }
 }
 
-// gpu::render keeps its per-call setup for the process's next render (render.cu's
+// gpu::render keeps its per-call setup for the process's next render (render_cache.cuh's
 // RenderCache, issue 30): equal chunks of a kept film reuse the kept wavefront pools,
 // renders of other strategies in between release them, and every film stays the one
 // render's byte for byte (and the report's pool count the pools that ran).
