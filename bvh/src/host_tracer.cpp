@@ -19,7 +19,7 @@ void HostGpuTracer::render(const RenderSettings& settings, Film& film, RunReport
   const SceneView view = scene_.view();
   const BvhView bvh = bvh_.view();
   const PathConfig c = settings.path_config();
-  const uint32_t spp = settings.traced_spp();
+  const uint32_t spp = c.spp;
   // The band of rows traced (a rank's chunk, or the frame), split by pixels: a chunk of a
   // few rows must still keep every thread busy.
   const uint32_t p0 = c.first_pixel, p1 = p0 + settings.traced_pixels();

@@ -53,7 +53,7 @@ void render(const Scene& scene, const EmbreeScene& embree, const RenderSettings&
                     settings.traced_samples(), settings.progress);
   // Samples [first_sample, first_sample + traced_spp()) of each pixel of rows [first_row,
   // first_row + traced_rows()) (an MPI rank's share or chunk).
-  TraceJob job{embree, scene.view(), settings.path_config(), settings.traced_spp(), settings.traced_rows(), film,
+  TraceJob job{embree, scene.view(), settings.path_config(), settings.traced_rows(), film,
                progress, isa};
 
   const auto t0 = std::chrono::steady_clock::now();

@@ -226,7 +226,7 @@ void trace_tile_batched(const TraceJob& job, const BatchKernels& k, const ShadeT
   PixelPackets<W> packets;
   for (uint32_t y = tile.rows().begin(); y < tile.rows().end(); ++y)
     for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x)
-      for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; s += W)
+      for (uint32_t s = job.config.first_sample, end = s + job.config.spp; s < end; s += W)
         trace_samples_batched<W>(job, k, table, tiny, ctx, packets, y * job.config.width + x, s,
                                  int(std::min<uint32_t>(W, end - s)), local);
 }
@@ -254,14 +254,14 @@ template <class T, uint32_t Kinds> TraceTotals pixel_parallel(const TraceJob& jo
       for (uint32_t y = tile.rows().begin(); y < tile.rows().end(); ++y)
         for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
           const uint32_t pixel = y * w + x;
-          for (uint32_t s = job.config.first_sample, end = s + job.spp; s < end; ++s) {
+          for (uint32_t s = job.config.first_sample, end = s + job.config.spp; s < end; ++s) {
             Vec3f L = trace_path<T, Kinds>(job, ctx, pixel, s, local);
             ++local.paths;
             if (!job.film.add(pixel, L)) ++local.discarded;  // each pixel has one writer here
           }
         }
     }
-    job.progress.advance(uint64_t(tile.rows().size()) * tile.cols().size() * job.spp);
+    job.progress.advance(uint64_t(tile.rows().size()) * tile.cols().size() * job.config.spp);
   });
   TraceTotals t;
   locals.combine_each([&](const Local& l) {

@@ -36,7 +36,7 @@ template <class T, uint32_t Kinds, int W>
 TraceTotals wavefront(const TraceJob& job, uint64_t paths_in_flight, const BatchKernels* k,
                       std::unique_ptr<ShadeTable> table) {
   // Whole rows from first_pixel on (an MPI rank's band, or the frame).
-  SampleSource source(job.config.first_pixel, job.config.width * job.rows, job.spp, job.config.first_sample, W);
+  SampleSource source(job.config.first_pixel, job.config.width * job.rows, job.config.spp, job.config.first_sample, W);
   const int slices = std::max(1, tbb::this_task_arena::max_concurrency());
   const uint64_t per_slice = std::max<uint64_t>(W, (paths_in_flight + slices - 1) / slices);
   // A pool that cannot fit is a setting to lower, not a std::bad_alloc (exit 2, not 1).

@@ -22,7 +22,6 @@ struct TraceJob {
   const EmbreeScene& embree;
   SceneView scene;
   PathConfig config;
-  uint32_t spp;   // samples traced per pixel: config.first_sample onwards
   uint32_t rows;  // rows traced: config.first_pixel / width onwards
   Film& film;
   Progress& progress;

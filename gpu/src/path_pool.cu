@@ -55,7 +55,7 @@ void PathPool::begin(cudaStream_t stream, uint64_t first, uint64_t count, const 
       g.bvh_tris >= kPixelLatencyBoundTris ? kWavefrontCounterRoundsLatencyBound : kWavefrontCounterRounds;
 }
 
-bool PathPool::step(Launcher& launch, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, FilmDev film,
+bool PathPool::step(Launcher& launch, const GpuScene::Impl& g, const PathConfig& c, FilmDev film,
                     bool variance) {
   // Whether the frame is done is read from the plans the trace kernels write into
   // mapped host memory: no copy or synchronisation in the stream, so the GPU never
@@ -74,7 +74,7 @@ bool PathPool::step(Launcher& launch, const GpuScene::Impl& g, const PathConfig&
   with_traversal_kind(g.bvh, [&](auto kind) {  // trace compiled for the BVH layout
     constexpr int B = decltype(kind)::value;
     auto go = [&](auto kernel) {
-      launch.launch("trace", kernel, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film, spp);
+      launch.launch("trace", kernel, 0, g.view, c, g.bvh, cur, prim_.get(), sh, ctr, step, film);
     };
     // Without shadow rays nothing in trace touches the film: no variance variant.
     if (!shadows_.records) go(k_wf_trace<false, false, B>);
@@ -83,8 +83,8 @@ bool PathPool::step(Launcher& launch, const GpuScene::Impl& g, const PathConfig&
   });
   with_features(g.view.material_kinds, [&](auto kinds) {  // shade compiled for the scene's kinds
     constexpr uint32_t K = decltype(kinds)::value;
-    if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp, counter_rounds_);
-    else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, spp, counter_rounds_);
+    if (variance) launch.launch("shade", k_wf_shade<true, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, counter_rounds_);
+    else launch.launch("shade", k_wf_shade<false, K>, 0, g.view, c, cur, next, prim_.get(), sh, ctr, parity, film, counter_rounds_);
   });
   if (it < kLag) return true;
   const uint64_t seen = it - kLag;
@@ -120,7 +120,7 @@ int wavefront_pools(uint64_t total, uint64_t paths_in_flight) {
 }
 
 FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n, Launcher& launch,
-                      const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, uint64_t total, FilmDev film,
+                      const GpuScene::Impl& g, const PathConfig& c, uint64_t total, FilmDev film,
                       bool variance) {
   const cudaStream_t home = launch.stream();
   // streams[k] past its work: the others start, or streams[0] ends, after it (one pool
@@ -140,7 +140,7 @@ FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n
     for (int k = 0; k < n; ++k) {
       if (!going[size_t(k)]) continue;
       launch.set_stream(streams[k]);
-      if (!pools[k]->step(launch, g, c, spp, film, variance)) {
+      if (!pools[k]->step(launch, g, c, film, variance)) {
         going[size_t(k)] = false;
         --left;
       }

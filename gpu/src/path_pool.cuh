@@ -56,7 +56,7 @@ class PathPool {
   // once the host has seen an iteration with nothing to trace; finish() waits for the
   // stream and returns the result.
   void begin(cudaStream_t stream, uint64_t first, uint64_t count, const GpuScene::Impl& g);
-  bool step(Launcher& launch, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, FilmDev film, bool variance);
+  bool step(Launcher& launch, const GpuScene::Impl& g, const PathConfig& c, FilmDev film, bool variance);
   FrameResult finish(cudaStream_t stream);
 
  private:
@@ -109,7 +109,7 @@ int wavefront_pools(uint64_t total, uint64_t paths_in_flight);
 // contiguous ranges. Stats summed, iterations the most any pool took, paths in flight and
 // pool bytes summed.
 FrameResult run_pools(PathPool* const* pools, const cudaStream_t* streams, int n, Launcher& launch,
-                      const GpuScene::Impl& g, const PathConfig& c, uint32_t spp, uint64_t total, FilmDev film,
+                      const GpuScene::Impl& g, const PathConfig& c, uint64_t total, FilmDev film,
                       bool variance);
 
 }  // namespace pb::gpu

@@ -51,7 +51,7 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
 // L1 (issue bound), kPixelLatencyBlocks (8: 32 registers, spills) scenes that miss to L2
 // (latency bound).
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks>
-__global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint32_t spp, uint64_t total,
+__global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint64_t total,
                                                FilmDev film, PixelCounters* ctr) {
   kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
@@ -60,10 +60,10 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
   for_each_chunk<unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, [&](unsigned long long k) {
     const uint64_t g = k * 32 + lane;
     const bool valid = g < total;
-    const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / spp) : kNoPixel;
+    const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / c.spp) : kNoPixel;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % spp), n_bounce, n_shadow);
+      L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % c.spp), n_bounce, n_shadow);
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &ctr->stats.discarded);
@@ -93,7 +93,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
 
-FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
                       DeviceBuffer<PixelCounters>& counters, int min_blocks) {
   PB_CUDA_CHECK(cudaMemsetAsync(counters.get(), 0, sizeof(PixelCounters), stream));
@@ -106,7 +106,7 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
     // A thread a sample at most: a small frame leaves no warp without a chunk.
     const uint64_t threads = (total + 31) / 32 * 32;
     auto go = [&](auto kernel) {
-      launch.launch_persistent("pixel", kernel, threads, g.view, g.bvh, c, spp, total, film, counters.get());
+      launch.launch_persistent("pixel", kernel, threads, g.view, g.bvh, c, total, film, counters.get());
     };
     constexpr int kAny = kAnyKind;
     if (precision == Precision::Double) variance ? go(k_pixel<true, K, double, true, kAny, 1>) : go(k_pixel<false, K, double, true, kAny, 1>);

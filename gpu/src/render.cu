@@ -124,9 +124,8 @@ struct RenderSetup {
   const GpuScene::Impl& g;
   const PathConfig config;
   // Samples [first_sample, first_sample + traced_spp()) of each pixel (an MPI rank's share):
-  // the kernels map g to (pixel g / spp, sample config.first_sample + g % spp).
+  // the kernels map g to (pixel g / config.spp, sample config.first_sample + g % config.spp).
   const uint64_t total;
-  const uint32_t spp;
   const ShadowUse shadows;
 
   std::unique_ptr<ScopedStream> own_stream;  // without a cache
@@ -157,7 +156,6 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
       g(gpu_scene.impl()),
       config(s.path_config()),
       total(s.traced_samples()),
-      spp(s.traced_spp()),
       shadows(ShadowUse::of(scene, s)),
       own_stream(c ? nullptr : std::make_unique<ScopedStream>()),
       stream(c ? c->stream.s : own_stream->s),
@@ -249,9 +247,9 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
 
 FrameResult RenderSetup::run_frame(uint64_t n, bool variance) {
   if (settings.strategy == Strategy::Pixel)
-    return run_pixel(launch, stream, g, config, spp, n, fb.view, variance, settings.precision, settings.watertight,
+    return run_pixel(launch, stream, g, config, n, fb.view, variance, settings.precision, settings.watertight,
                      pixel_counters, occupancy.min_blocks);
-  return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, spp, n, fb.view,
+  return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, n, fb.view,
                    variance);
 }
 

@@ -76,10 +76,10 @@ struct PixelCounters {
   unsigned long long chunks;
 };
 
-// The pixel megakernel over `total` samples (spp per pixel), compiled for the scene's
+// The pixel megakernel over `total` samples (c.spp per pixel), compiled for the scene's
 // material kinds; `counters` is its counter block on the device; `min_blocks` from
 // pixel_occupancy (float and watertight only: the accuracy variants keep the compiler's).
-FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c, uint32_t spp,
+FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
                       DeviceBuffer<PixelCounters>& counters, int min_blocks);
 

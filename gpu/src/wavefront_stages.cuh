@@ -149,7 +149,7 @@ __device__ __forceinline__ void trace_closest(const SceneView& s, const PathConf
 template <bool kVariance, bool kShadows, int kKind>  // kKind: the BVH layout (traversal.h)
 __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>)
     k_wf_trace(SceneView s, PathConfig c, BvhView bvh, PathSoA cur, uint32_t* prim, ShadowSoA sh, WaveCounters* ctr,
-               WaveStep step, FilmDev film, uint32_t spp) {
+               WaveStep step, FilmDev film) {
   kernel_prologue();
   const IterationCounters& prev = ctr->it[step.parity ^ 1u];
   const IterationPlan plan = plan_iteration(prev, step.total, step.capacity);
@@ -161,7 +161,7 @@ __global__ void __launch_bounds__(256, kTraversalBlocksPerSm<kKind>)
     __threadfence_system();
   }
   const uint32_t n = plan.n_cur;
-  const NewPaths fresh{plan.gen_dst, plan.gen_base, spp};
+  const NewPaths fresh{plan.gen_dst, plan.gen_base, c.spp};
   unsigned long long* discarded = &ctr->stats.discarded;
   // The shadow rays first, then the closest hits, each in chunks (for_each_chunk).
   if constexpr (kShadows) {
@@ -244,11 +244,11 @@ __device__ __forceinline__ void shade_chunk(const SceneView& s, const PathConfig
 template <bool kVariance, uint32_t Kinds>
 __global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, uint32_t parity,
-                                                     FilmDev film, uint32_t spp, uint32_t counter_rounds) {
+                                                     FilmDev film, uint32_t counter_rounds) {
   kernel_prologue();
   IterationCounters& at = ctr->it[parity];
   const uint32_t n = at.n_cur;
-  const NewPaths fresh{at.gen_dst, at.gen_base, spp};
+  const NewPaths fresh{at.gen_dst, at.gen_base, c.spp};
   if (grid_thread() == 0) {  // the next trace's counters: this iteration's trace is done
     ctr->chunks.shadow = 0;
     ctr->chunks.closest = 0;

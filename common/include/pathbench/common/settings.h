@@ -50,6 +50,9 @@ struct PathConfig {
   // The first pixel this render traces (RenderSettings::first_row x width): the traced
   // pixels are [first_pixel, first_pixel + width x traced rows), whole rows.
   uint32_t first_pixel = 0;
+  // Samples this render traces per pixel, from first_sample on (RenderSettings::traced_spp()):
+  // a sample g of the render is (pixel first_pixel + g / spp, sample first_sample + g % spp).
+  uint32_t spp = 0;
 };
 
 struct RenderSettings {
@@ -82,7 +85,7 @@ struct RenderSettings {
 
   PathConfig path_config() const {
     return {max_bounces, sampling, russian_roulette, rr_start_depth, width, height, seed, first_sample,
-            first_row * width};
+            first_row * width, traced_spp()};
   }
   uint64_t total_samples() const { return uint64_t(width) * height * spp; }
   uint32_t traced_spp() const { return sample_count ? sample_count : spp - first_sample; }
