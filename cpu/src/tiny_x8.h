@@ -27,18 +27,14 @@
 namespace pb::cpu::PB_SIMD_NS {
 
 #if PB_SIMD_LANES == 16
-inline FV fmadd(FV a, FV b, FV c) { return FV(_mm512_fmadd_ps(__m512(a), __m512(b), __m512(c))); }
 inline FV fmsub(FV a, FV b, FV c) { return FV(_mm512_fmsub_ps(__m512(a), __m512(b), __m512(c))); }
 #else
-inline FV fmadd(FV a, FV b, FV c) { return FV(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c))); }
 inline FV fmsub(FV a, FV b, FV c) { return FV(_mm256_fmsub_ps(__m256(a), __m256(b), __m256(c))); }
 #endif
 
-// Embree's Vec3 dot and cross (common/math/vec3.h): madd / msub are single FMAs.
-inline FV emb_dot(V3 a, V3 b) { return fmadd(a.x, b.x, fmadd(a.y, b.y, a.z * b.z)); }
-inline V3 emb_cross(V3 a, V3 b) {
-  return {fmsub(a.y, b.z, a.z * b.y), fmsub(a.z, b.x, a.x * b.z), fmsub(a.x, b.y, a.y * b.x)};
-}
+// Embree's Vec3 dot and cross (common/math/vec3.h), madd / msub as single FMAs, are the
+// path step's fused fdot and fcross (simd8.h): the same operations, so the same bits
+// (fcross's a*b + -(c*d) rounds as msub's a*b - c*d).
 // Embree's stable_triangle_normal(a, b, c) (common/math/vec3.h): per component, the
 // cross product of the pair whose subtracted product is smaller.
 inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
@@ -58,8 +54,8 @@ inline V3 emb_stable_normal(V3 a, V3 b, V3 c) {
 // up to a found hit, misses.
 inline IV plane_away(const TinyScene::Triangle& tr, V3 o, V3 d, FV t_end, FV scale) {
   const V3 n{splat(tr.n[0]), splat(tr.n[1]), splat(tr.n[2])};
-  const FV s0 = fmadd(n.x, o.x, fmadd(n.y, o.y, fmsub(n.z, o.z, splat(tr.c))));
-  const FV s1 = fmadd(t_end, emb_dot(n, d), s0);
+  const FV s0 = madd_v(n.x, o.x, madd_v(n.y, o.y, fmsub(n.z, o.z, splat(tr.c))));
+  const FV s1 = madd_v(t_end, fdot(n, d), s0);
   const FV mu = scale * tr.cull_k;
   return ((s0 > mu) & (s1 > mu)) | ((s0 < -mu) & (s1 < -mu));
 }
@@ -100,14 +96,14 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   // arithmetic too, and clear of its interval.
   const FV dmax = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
   const FV cull_base = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)) + s.pmax;
-  const FV shadow_scale = fmadd(tfar, dmax, cull_base);
+  const FV shadow_scale = madd_v(tfar, dmax, cull_base);
   for (const TinyScene::Triangle& tr : s.triangles) {
     if constexpr (AnyHit) {
       // Skipped where every lane is away or blocked already.
       if (lane_mask(~plane_away(tr, o, d, tfar, shadow_scale) & (r.best == inf)) == 0) continue;
     } else if (lane_mask(r.best == inf) == 0) {
       const FV t_end = r.best + r.best_err;
-      if (lane_mask(~plane_away(tr, o, d, t_end, fmadd(t_end, dmax, cull_base))) == 0) continue;
+      if (lane_mask(~plane_away(tr, o, d, t_end, madd_v(t_end, dmax, cull_base))) == 0) continue;
     }
     const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
     const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
@@ -120,9 +116,9 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
       IV outside, inside_any;  // inside_any: inside, before the grazing test
     };
     auto edges = [&] {
-      const FV U = emb_dot(emb_cross(e0, v2 + v0), d);
-      const FV V = emb_dot(emb_cross(e1, v0 + v1), d);
-      const FV W = emb_dot(emb_cross(e2, v1 + v2), d);
+      const FV U = fdot(fcross(e0, v2 + v0), d);
+      const FV V = fdot(fcross(e1, v0 + v1), d);
+      const FV W = fdot(fcross(e2, v1 + v2), d);
       const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
       const FV m = m_scale * tr.edge;
       return Edges{(hi > m) & (lo < -m), (lo > m) | (hi < -m)};
@@ -133,9 +129,9 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     };
     auto depth = [&] {
       const V3 ng = emb_stable_normal(e0, e1, e2);
-      FV den = emb_dot(ng, d);
+      FV den = fdot(ng, d);
       den = den + den;
-      FV T = emb_dot(v0, ng);
+      FV T = fdot(v0, ng);
       T = T + T;
       Depth z;
       z.abs_den = abs(den);
