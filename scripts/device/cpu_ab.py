@@ -3,12 +3,14 @@
 paper-cornell SIZE x SIZE x SPP (2 bounces, nee) once per round for each strategy and ISA,
 the order of the builds alternating from round to round; the render seconds are the
 report's own (`seconds`: the render, without start-up). Prints medians, min-max and a
-two-sided Mann-Whitney U test of each build against the first; writes all runs as JSON.
+two-sided Mann-Whitney U test of each build against the first, and whether each build's
+images are one (and the first build's); writes all runs as JSON.
 
     scripts/device/cpu_ab.py --bin main=/tmp/b-main/bin/pathbench --bin new=build/bin/pathbench \
         --strategies pixel,wavefront --isa auto,avx2 --rounds 7 --out ab.json
 """
 import argparse
+import hashlib
 import json
 import os
 import statistics
@@ -26,7 +28,9 @@ def render(exe, strategy, isa, size, spp, threads, tmp, extra):
     if p.returncode != 0:
         sys.exit(f"cpu_ab.py: {' '.join(cmd)}: exit {p.returncode}: {p.stderr.strip()}")
     r = json.load(open(rep))
-    return r["seconds"], r.get("extra", {}).get("isa"), p.stderr
+    with open(os.path.join(tmp, "i.pfm"), "rb") as f:
+        film = hashlib.sha256(f.read()).hexdigest()[:16]
+    return r["seconds"], r.get("extra", {}).get("isa"), p.stderr, film
 
 
 def main():
@@ -50,9 +54,9 @@ def main():
             for s in a.strategies.split(","):
                 for isa in a.isa.split(","):
                     for name, exe in order:
-                        sec, used, err = render(exe, s, isa, a.size, a.spp, a.threads, tmp, a.extra.split())
+                        sec, used, err, film = render(exe, s, isa, a.size, a.spp, a.threads, tmp, a.extra.split())
                         runs.append({"round": k, "build": name, "strategy": s, "isa": isa, "isa_used": used,
-                                     "seconds": sec})
+                                     "seconds": sec, "film_sha": film})
                         if a.stderr_to and err:
                             with open(a.stderr_to, "a") as f:
                                 f.write(f"== round {k} {name} {s} {isa}\n{err}")
@@ -65,12 +69,18 @@ def main():
     base = bins[0][0]
     for s in a.strategies.split(","):
         for isa in a.isa.split(","):
-            ref = [r["seconds"] for r in runs if r["build"] == base and r["strategy"] == s and r["isa"] == isa]
+            case = [r for r in runs if r["strategy"] == s and r["isa"] == isa]
+            ref = [r["seconds"] for r in case if r["build"] == base]
+            ref_films = {r["film_sha"] for r in case if r["build"] == base}
             for name, _ in bins:
-                x = [r["seconds"] for r in runs if r["build"] == name and r["strategy"] == s and r["isa"] == isa]
+                x = [r["seconds"] for r in case if r["build"] == name]
+                films = {r["film_sha"] for r in case if r["build"] == name}
+                same = "one image" if len(films) == 1 else f"{len(films)} images"
+                if name != base:
+                    same += ", = " + base if films == ref_films else ", != " + base
                 p = mannwhitneyu(x, ref).pvalue if mannwhitneyu and name != base else float("nan")
                 print(f"{s:>9} {isa:>6} {name:>8}: median {statistics.median(x):.4f} s [{min(x):.4f}-{max(x):.4f}] "
-                      f"/ {base} {statistics.median(x) / statistics.median(ref):.3f}  p={p:.3g}")
+                      f"/ {base} {statistics.median(x) / statistics.median(ref):.3f}  p={p:.3g}  {same}")
 
 
 if __name__ == "__main__":
