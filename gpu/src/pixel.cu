@@ -50,7 +50,16 @@ __device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, 
 // (docs/notes/gpu-log.md, "Occupancy of the megakernel"): 3 blocks suit scenes whose BVH sits in
 // L1 (issue bound), kPixelLatencyBlocks (8: 32 registers, spills) scenes that miss to L2
 // (latency bound).
-template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks>
+// kParked: each thread's path state and shadow query live in the block's shared memory
+// (25 words a thread, an odd stride: no bank conflicts) instead of registers, so that the
+// traversals, where the register peak is, run with ~25 registers fewer live.
+template <class T> struct ParkedPath {
+  PathState<T> st;
+  ShadowQuery<T> q;
+};
+static_assert(sizeof(ParkedPath<float>) == 100, "25 words: an odd stride in words");
+
+template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks, bool kParked = false>
 __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint64_t total,
                                                FilmDev film, PixelCounters* ctr) {
   kernel_prologue();
@@ -63,7 +72,14 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
     const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / c.spp) : kNoPixel;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
-      L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % c.spp), n_bounce, n_shadow);
+      if constexpr (kParked) {
+        __shared__ ParkedPath<T> parked[256];
+        ParkedPath<T>& p = parked[threadIdx.x];
+        L = trace_path_bvh_in<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % c.spp),
+                                                            n_bounce, n_shadow, p.st, p.q);
+      } else {
+        L = trace_path_bvh<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % c.spp), n_bounce, n_shadow);
+      }
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &ctr->stats.discarded);
@@ -73,18 +89,22 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
 
 }  // namespace
 
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
+namespace {
+PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
   const bool wide = g.bvh.kind == TraversalKind::Wide;
+  const bool leaves = g.bvh.kind == TraversalKind::Leaves;
   const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   const std::string v = env ? env : "auto";
   if (v != "auto") {
-    bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks);
+    bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) || (!wide && v == "5");
     if (wide)
       for (int n : kWidePixelBlocks) ok = ok || v == std::to_string(n);
+    if (leaves)
+      for (int n : kLeavesPixelBlocks) ok = ok || v == std::to_string(n);
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
-                                   "auto, 3, 5 or 8)", v, kPixelLatencyBlocks));
+                                   "auto, 3, 5 or 8; the leaves layout: auto, 3, 4, 5 or 8)", v, kPixelLatencyBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }
   if (g.bvh_tris >= kPixelLatencyBoundTris)
@@ -92,10 +112,25 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
                                  kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
+}  // namespace
+
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
+  PixelOccupancy o = pixel_blocks(g);
+  const bool leaves = g.bvh.kind == TraversalKind::Leaves, binary = g.bvh.kind == TraversalKind::Binary;
+  const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
+  const std::string v = env ? env : "auto";
+  if (v == "auto") o.parked = leaves;
+  else if (v == "0" || v == "1") o.parked = v == "1";
+  else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
+  // Compiled for the leaves layout (every count but 8) and the binary BVH's 5 and 8 blocks.
+  if (o.parked && !((leaves && o.min_blocks != 8) || (binary && o.min_blocks >= 5))) o.parked = false;
+  if (o.parked) o.why += "; path state parked in shared memory";
+  return o;
+}
 
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<PixelCounters>& counters, int min_blocks) {
+                      DeviceBuffer<PixelCounters>& counters, int min_blocks, bool parked) {
   PB_CUDA_CHECK(cudaMemsetAsync(counters.get(), 0, sizeof(PixelCounters), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
   // In float with the watertight test, compiled for the scene's BVH layout and the
@@ -116,6 +151,10 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
         constexpr int B = decltype(kind)::value;
         auto at = [&](auto blocks) {
           constexpr int N = decltype(blocks)::value;
+          // The parked path state (pixel_occupancy says where): the leaves layout, the binary BVH at 5 and 8.
+          if constexpr ((B == int(TraversalKind::Leaves) && N != 8) || (B == int(TraversalKind::Binary) && N >= 5)) {
+            if (parked) return variance ? go(k_pixel<true, K, float, true, B, N, true>) : go(k_pixel<false, K, float, true, B, N, true>);
+          }
           variance ? go(k_pixel<true, K, float, true, B, N>) : go(k_pixel<false, K, float, true, B, N>);
         };
         using I = std::integral_constant<int, 3>;
@@ -123,6 +162,15 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
           static_assert(kWideLatencyBlocks == 5 && kPixelLatencyBlocks == 8, "kWidePixelBlocks: 3, 5, 8");
           if (min_blocks == 5) at(std::integral_constant<int, 5>{});
           else if (min_blocks == 8) at(std::integral_constant<int, 8>{});
+          else at(I{});
+        } else if constexpr (B == int(TraversalKind::Leaves)) {  // kLeavesPixelBlocks
+          if (min_blocks == 4) at(std::integral_constant<int, 4>{});
+          else if (min_blocks == 5) at(std::integral_constant<int, 5>{});
+          else if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
+          else at(I{});
+        } else if constexpr (B == int(TraversalKind::Binary)) {
+          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
+          else if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
           else at(I{});
         } else {
           if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});

@@ -44,6 +44,9 @@ struct ShadowUse {
 struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
+  // The path state parked in shared memory (pixel.cu, ParkedPath) instead of registers.
+  // PATHBENCH_GPU_PIXEL_PARKED=auto|0|1; auto: the leaves layout (kParkedAuto).
+  bool parked = false;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // The latency-bound build: 8 blocks (32 registers, ~700 bytes of spills) since the slab
@@ -60,6 +63,10 @@ constexpr int kPixelLatencyBlocks = 8;
 // megakernel per material set and variance flag in pixel.cu's compile).
 constexpr int kWidePixelBlocks[] = {3, 5, 8};
 constexpr int kWideLatencyBlocks = 5;
+// The leaves layout's megakernel (tiny scenes, issue bound at 3 blocks: 80 registers, 37 %
+// of warps active) is compiled for 4 and 5 blocks too (64 and 48 registers), for
+// PATHBENCH_GPU_PIXEL_BLOCKS to measure.
+constexpr int kLeavesPixelBlocks[] = {3, 4, 5, 8};
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from
@@ -81,6 +88,6 @@ struct PixelCounters {
 // pixel_occupancy (float and watertight only: the accuracy variants keep the compiler's).
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<PixelCounters>& counters, int min_blocks);
+                      DeviceBuffer<PixelCounters>& counters, int min_blocks, bool parked = false);
 
 }  // namespace pb::gpu

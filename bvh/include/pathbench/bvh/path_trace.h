@@ -28,12 +28,14 @@ PB_HD bool gpu_final_vertex(const SceneView& s, const PathConfig& c, const PathS
 // float either way; surface_hit recomputes the hit in T), with the watertight or the
 // Moeller-Trumbore triangle test, through the BVH layout kKind (traversal.h). Counts its
 // bounce and shadow rays into n_bounce and n_shadow.
+// The path's state st and its shadow query q live where the caller keeps them: in registers
+// (trace_path_bvh below), or in the GPU block's shared memory (pixel.cu's parked state,
+// which frees their registers while the traversals run).
 template <uint32_t Kinds, class T, bool kWatertight, int kKind>
-PB_HD Vec3f trace_path_bvh(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
-                           uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
-  PathState<T> st;
+PB_HD Vec3f trace_path_bvh_in(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
+                              uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow, PathState<T>& st,
+                              ShadowQuery<T>& q) {
   path_begin(s, c, pixel, sample, st);
-  ShadowQuery<T> q;
   auto occlusion_test = [&](const ShadowQuery<T>& query) {  // query: q, filled just before
     ++n_shadow;
     if (!occluded<kWatertight, kKind>(bvh, Vec3f(query.ray.o), Vec3f(query.ray.d), 1.0f)) shadow_unoccluded(st, query);
@@ -53,6 +55,14 @@ PB_HD Vec3f trace_path_bvh(const SceneView& s, const BvhView& bvh, const PathCon
     if (ev == PathEvent::Done) break;
   }
   return Vec3f(st.L);
+}
+
+template <uint32_t Kinds, class T, bool kWatertight, int kKind>
+PB_HD Vec3f trace_path_bvh(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
+                           uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow) {
+  PathState<T> st;
+  ShadowQuery<T> q;
+  return trace_path_bvh_in<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, sample, n_bounce, n_shadow, st, q);
 }
 
 }  // namespace pb::bvh
