@@ -87,24 +87,22 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
   block_stats_add(&ctr->stats, n_bounce, n_shadow, n_paths);
 }
 
-}  // namespace
-
-namespace {
+// The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy).
 PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
   const bool wide = g.bvh.kind == TraversalKind::Wide;
-  const bool leaves = g.bvh.kind == TraversalKind::Leaves;
+  // The leaves layout (kLeavesPixelBlocks) and the binary BVH are compiled for 5 blocks too.
+  const bool five = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Binary;
   const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   const std::string v = env ? env : "auto";
   if (v != "auto") {
-    bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) || (!wide && v == "5");
+    bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) || (five && v == "5");
     if (wide)
       for (int n : kWidePixelBlocks) ok = ok || v == std::to_string(n);
-    if (leaves)
-      for (int n : kLeavesPixelBlocks) ok = ok || v == std::to_string(n);
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
-                                   "auto, 3, 5 or 8; the leaves layout: auto, 3, 4, 5 or 8)", v, kPixelLatencyBlocks));
+                                   "auto, 3, 5 or 8; the leaves layout and the binary BVH: also 5)", v,
+                                   kPixelLatencyBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }
   if (g.bvh_tris >= kPixelLatencyBoundTris)
@@ -124,7 +122,13 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
   // Compiled for the leaves layout (every count but 8) and the binary BVH's 5 and 8 blocks.
   if (o.parked && !((leaves && o.min_blocks != 8) || (binary && o.min_blocks >= 5))) o.parked = false;
-  if (o.parked) o.why += "; path state parked in shared memory";
+  const char* blocks = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
+    o.min_blocks = kLeavesParkedBlocks;
+    o.why = fmt::format("auto: the leaves layout, its path state parked: {} blocks", kLeavesParkedBlocks);
+  } else if (o.parked) {
+    o.why += "; path state parked in shared memory";
+  }
   return o;
 }
 
@@ -164,8 +168,8 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
           else if (min_blocks == 8) at(std::integral_constant<int, 8>{});
           else at(I{});
         } else if constexpr (B == int(TraversalKind::Leaves)) {  // kLeavesPixelBlocks
-          if (min_blocks == 4) at(std::integral_constant<int, 4>{});
-          else if (min_blocks == 5) at(std::integral_constant<int, 5>{});
+          static_assert(kLeavesParkedBlocks == 5, "kLeavesPixelBlocks: 3, 5, 8");
+          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
           else if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
           else at(I{});
         } else if constexpr (B == int(TraversalKind::Binary)) {

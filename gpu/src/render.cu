@@ -377,7 +377,9 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
     std::fputs(Launcher::format_table(prof).c_str(), stdout);
   }
   if (settings.strategy == Strategy::Pixel)
-    x["paths_in_flight_note"] = "pixel: one thread per sample, path state in registers";
+    x["paths_in_flight_note"] = su.occupancy.parked
+                                    ? "pixel: one thread per sample, path state in the block's shared memory"
+                                    : "pixel: one thread per sample, path state in registers";
 }
 
 void render_impl(const Scene& scene, const GpuScene& gpu_scene, const RenderSettings& settings, Film& film,

@@ -45,7 +45,10 @@ struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
   // The path state parked in shared memory (pixel.cu, ParkedPath) instead of registers.
-  // PATHBENCH_GPU_PIXEL_PARKED=auto|0|1; auto: the leaves layout (kParkedAuto).
+  // PATHBENCH_GPU_PIXEL_PARKED=auto|0|1; auto: the leaves layout (at kLeavesParkedBlocks
+  // unless PATHBENCH_GPU_PIXEL_BLOCKS says otherwise). 1 also parks the binary BVH's at 5
+  // and 8 blocks (paper-cornell-ico:8 at 8: 40.53 -> 39.93 ms; not yet the default: the
+  // other latency-bound scenes, whose L1 it shrinks, are not measured).
   bool parked = false;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
@@ -63,10 +66,15 @@ constexpr int kPixelLatencyBlocks = 8;
 // megakernel per material set and variance flag in pixel.cu's compile).
 constexpr int kWidePixelBlocks[] = {3, 5, 8};
 constexpr int kWideLatencyBlocks = 5;
-// The leaves layout's megakernel (tiny scenes, issue bound at 3 blocks: 80 registers, 37 %
-// of warps active) is compiled for 4 and 5 blocks too (64 and 48 registers), for
-// PATHBENCH_GPU_PIXEL_BLOCKS to measure.
-constexpr int kLeavesPixelBlocks[] = {3, 4, 5, 8};
+// The leaves layout's megakernel is compiled for 3, 5 and 8 blocks (PATHBENCH_GPU_PIXEL_BLOCKS).
+// With the path state parked in shared memory (PixelOccupancy::parked, pixel.cu's ParkedPath)
+// it needs 64 registers and spills nothing (in registers: 80 and 28 / 16 bytes spilled), and
+// auto gives it kLeavesParkedBlocks. H100, paper-cornell 256x256x800 nee, same films
+// (docs/notes/gpu-log.md, "The path state parked in shared memory"): in registers at 3
+// blocks 10.645 ms, at 4 10.749, at 5 10.454; parked at 3 (64 registers: 4 blocks run)
+// 10.245, parked at 5 (48 registers, 100 / 84 bytes spilled) 10.131.
+constexpr int kLeavesPixelBlocks[] = {3, 5, 8};
+constexpr int kLeavesParkedBlocks = 5;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from

@@ -171,6 +171,60 @@ TEST(GpuWavefrontPools, BitIdenticalForAnyPoolCount) {
   ::unsetenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
 }
 
+// The megakernel's path state parked in shared memory (PATHBENCH_GPU_PIXEL_PARKED; auto: the
+// leaves layout) or kept in registers: the same arithmetic, so the same film bit for bit, on
+// the leaves layout (paper-cornell) and on the binary BVH at 5 and 8 blocks (ico:3, binary by
+// name); the report says which ran. A value the variable cannot mean is an InputError naming it.
+TEST(GpuPixelParked, SameFilmAsInRegisters) {
+  PB_REQUIRE_GPU();
+  auto parked_of = [](const RunReport& r) { return r.extra["pixel_occupancy"]["parked_path_state"].get<bool>(); };
+  const RenderSettings s = small_settings(Strategy::Pixel, 64, 64);
+  {
+    const Scene scene = load_scene("paper-cornell");
+    const GpuScene gs(scene);
+    RunReport r;
+    const Film parked = render_gpu(scene, gs, s, &r);  // auto: parked, at kLeavesParkedBlocks
+    EXPECT_TRUE(parked_of(r));
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "0", 1);
+    expect_identical(parked, render_gpu(scene, gs, s, &r), "leaves: parked vs in registers");
+    EXPECT_FALSE(parked_of(r));
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "1", 1);
+    ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", "3", 1);
+    expect_identical(parked, render_gpu(scene, gs, s, &r), "leaves: parked at 3 blocks");
+    EXPECT_TRUE(parked_of(r));
+  }
+  {
+    const Scene scene = load_scene("paper-cornell-ico:3");
+    GpuBvhOptions o;
+    o.layout = GpuBvhLayout::Binary;
+    const GpuScene gs(scene, o);
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "0", 1);
+    ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+    const Film in_registers = render_gpu(scene, gs, s);
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "1", 1);
+    for (const char* blocks : {"5", "8"}) {
+      ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", blocks, 1);
+      RunReport r;
+      const std::string what = std::string("binary: parked at ") + blocks + " blocks";
+      expect_identical(in_registers, render_gpu(scene, gs, s, &r), what.c_str());
+      EXPECT_TRUE(parked_of(r)) << what;
+      EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], std::stoi(blocks)) << what;
+    }
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "yes", 1);
+    Film f(s.width, s.height, false);
+    RunReport r;
+    f.begin(s.spp, scene.max_emission());
+    try {
+      render(scene, gs, s, f, r, false);
+      ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("PATHBENCH_GPU_PIXEL_PARKED"), std::string::npos) << e.what();
+    }
+  }
+  ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
+  ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+}
+
 // GPU against the CPU tracer, same seed and settings: with one random stream the
 // images differ only where rounding sends a path to another triangle.
 void gpu_vs_cpu(const char* name) {
