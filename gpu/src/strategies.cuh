@@ -39,7 +39,7 @@ struct ShadowUse {
 // The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
 // and the megakernel waits on memory (more warps hide it); below, it is issue bound.
-// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 overrides it (a bad value: InputError); the wide
+// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 (5 too for the leaves and binary layouts) overrides it (a bad value: InputError); the wide
 // BVH's megakernel is compiled for more counts (kWidePixelBlocks) and takes any of them.
 struct PixelOccupancy {
   int min_blocks = 3;

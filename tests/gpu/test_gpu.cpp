@@ -57,6 +57,20 @@ Film render_gpu(const Scene& scene, const GpuScene& gs, RenderSettings s, RunRep
   return film;
 }
 
+// The render refuses the settings (an environment variable's value) with an InputError
+// naming `variable`.
+void expect_refused_naming(const Scene& scene, const GpuScene& gs, const RenderSettings& s, const char* variable) {
+  Film f(s.width, s.height, false);
+  RunReport r;
+  f.begin(s.spp, scene.max_emission());
+  try {
+    render(scene, gs, s, f, r, false);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(variable), std::string::npos) << e.what();
+  }
+}
+
 void expect_identical(const Film& a, const Film& b, const char* what) {
   ASSERT_EQ(a.raw_sums().size(), b.raw_sums().size());
   size_t differ = 0;
@@ -159,15 +173,7 @@ TEST(GpuWavefrontPools, BitIdenticalForAnyPoolCount) {
       EXPECT_EQ(r.extra["pools"], std::stoi(pools)) << what;
     }
   ::setenv("PATHBENCH_GPU_WAVEFRONT_POOLS", "5", 1);
-  Film f(s.width, s.height, false);
-  RunReport r;
-  f.begin(s.spp, scene.max_emission());
-  try {
-    render(scene, gs, s, f, r, false);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("PATHBENCH_GPU_WAVEFRONT_POOLS"), std::string::npos) << e.what();
-  }
+  expect_refused_naming(scene, gs, s, "PATHBENCH_GPU_WAVEFRONT_POOLS");
   ::unsetenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
 }
 
@@ -211,15 +217,7 @@ TEST(GpuPixelParked, SameFilmAsInRegisters) {
       EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], std::stoi(blocks)) << what;
     }
     ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "yes", 1);
-    Film f(s.width, s.height, false);
-    RunReport r;
-    f.begin(s.spp, scene.max_emission());
-    try {
-      render(scene, gs, s, f, r, false);
-      ADD_FAILURE() << "no InputError";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("PATHBENCH_GPU_PIXEL_PARKED"), std::string::npos) << e.what();
-    }
+    expect_refused_naming(scene, gs, s, "PATHBENCH_GPU_PIXEL_PARKED");
   }
   ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
   ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
