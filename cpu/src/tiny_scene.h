@@ -51,6 +51,72 @@ struct TinyScene {
   float lo[3], hi[3];  // bounds of every vertex
   float pmax;          // largest |vertex coordinate| (the cull's scale)
 
+  // The axis-plane test (tiny_x8.h `axis_candidate`; docs/notes/cpu-log.md, 2026-11-27 "issue
+  // 35, part 2", gives the error argument). A triangle whose three vertices share one
+  // coordinate exactly (x_k = P: a wall of a box) is tested without Embree's arithmetic:
+  // for it Embree's normal has exact zeros off axis k, so Embree's t is (P - o_k) / D_k up
+  // to a few roundings whatever its normal's own rounding, and the edge functions are a 2D
+  // test in the plane, bounded against exact arithmetic (Embree's and ours). k = -1: the
+  // triangle is not such a triangle (or out of the ranges the argument needs): Embree's
+  // formulas, as before.
+  struct alignas(64) AxisRow {
+    int32_t k = -1, i = 0, j = 0;  // normal axis, the two in-plane axes
+    float P = 0.0f;                // the plane x_k = P
+    float q0i = 0.0f, q0j = 0.0f;  // vertex v0's in-plane coordinates
+    // Edge functions of Y = X - v0 (X: where the ray meets the plane, in-plane axes i, j):
+    // f_e = n_e . Y (+ c1 for the edge v1 -> v2), twice the signed area of (edge, X),
+    // oriented so that f > 0 inside; f_0 + f_1 + f_2 = A (twice the area).
+    float n[3][2] = {};
+    float c1 = 0.0f;
+    float pad[3] = {};
+  };
+  static_assert(sizeof(AxisRow) == 64);
+  std::vector<AxisRow> axis;  // one per triangle
+  bool any_axis = false;
+  float axis_e = 0.0f;        // largest |edge component| of the axis-plane triangles
+  float axis_m_ok = 0.0f;     // a ray uses the axis-plane test only where M <= this (min 2^14 A / E)
+
+  // The axis-plane row of r, where r qualifies (the ranges the error argument needs:
+  // coordinates at most 2^20, P zero or at least 2^-20, A in [2^-20, 2^40], no sliver:
+  // A >= 2^-19 E^2).
+  static AxisRow axis_row(const Triangle& r, double& e_out, double& m_ok_out) {
+    AxisRow a;
+    int k = -1;
+    for (int c = 0; c < 3; ++c)
+      if (r.p[c] == r.p[3 + c] && r.p[c] == r.p[6 + c]) k = (k == -1 ? c : 3);
+    if (k < 0 || k > 2) return a;
+    for (float x : r.p)
+      if (!(std::fabs(x) <= 0x1p20f)) return a;
+    const double P = r.p[k];
+    if (P != 0.0 && std::fabs(P) < 0x1p-20) return a;
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    double q[3][2];
+    for (int v = 0; v < 3; ++v) q[v][0] = r.p[3 * v + i], q[v][1] = r.p[3 * v + j];
+    auto cross2 = [](double ai, double aj, double bi, double bj) { return ai * bj - aj * bi; };
+    const double area2 = cross2(q[1][0] - q[0][0], q[1][1] - q[0][1], q[2][0] - q[0][0], q[2][1] - q[0][1]);
+    const double A = std::fabs(area2);
+    double E = 0.0;
+    for (int v = 0; v < 3; ++v)
+      for (int c = 0; c < 2; ++c) E = std::max(E, std::fabs(q[(v + 1) % 3][c] - q[v][c]));
+    if (!(A >= 0x1p-20 && A <= 0x1p40 && A >= 0x1p-19 * E * E)) return a;
+    const double sg = area2 > 0.0 ? 1.0 : -1.0;
+    // Edge a -> b: f = sg cross2(b - a, X - a) = sg ((b - a)_i Y_j - (b - a)_j Y_i) + c.
+    const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
+    for (int e = 0; e < 3; ++e) {
+      const double di = q[to[e]][0] - q[from[e]][0], dj = q[to[e]][1] - q[from[e]][1];
+      a.n[e][0] = float(-sg * dj);
+      a.n[e][1] = float(sg * di);
+    }
+    // Edge 1 -> 2 does not pass through v0: c1 = -sg cross2(q2 - q1, q1 - q0).
+    a.c1 = float(-sg * cross2(q[2][0] - q[1][0], q[2][1] - q[1][1], q[1][0] - q[0][0], q[1][1] - q[0][1]));
+    a.k = k, a.i = i, a.j = j;
+    a.P = float(P);
+    a.q0i = float(q[0][0]), a.q0j = float(q[0][1]);
+    e_out = E;
+    m_ok_out = 0x1p14 * A / E;
+    return a;
+  }
+
   // r's plane in double, rounded to float; a degenerate triangle is never culled.
   static void set_plane(Triangle& r, double pmax) {
     double a[3], b[3], c[3];
@@ -108,6 +174,19 @@ struct TinyScene {
     t->pmax = 0.0f;
     for (int j = 0; j < 3; ++j) t->pmax = std::max({t->pmax, std::fabs(t->lo[j]), std::fabs(t->hi[j])});
     for (Triangle& r : t->triangles) set_plane(r, t->pmax);
+    double axis_e = 0.0, axis_m_ok = 0x1p100;
+    for (const Triangle& r : t->triangles) {
+      double e = 0.0, m_ok = 0.0;
+      t->axis.push_back(axis_row(r, e, m_ok));
+      if (t->axis.back().k < 0) continue;
+      t->any_axis = true;
+      axis_e = std::max(axis_e, e);
+      axis_m_ok = std::min(axis_m_ok, m_ok);
+    }
+    if (t->any_axis) {
+      t->axis_e = std::nextafter(float(axis_e), __builtin_inff());  // rounded up
+      t->axis_m_ok = std::nextafter(float(axis_m_ok), 0.0f);         // rounded down
+    }
     return t;
   }
 };
