@@ -51,36 +51,39 @@ struct TinyScene {
   float lo[3], hi[3];  // bounds of every vertex
   float pmax;          // largest |vertex coordinate| (the cull's scale)
 
-  // The axis-plane test (tiny_x8.h `axis_candidate`; docs/notes/cpu-log.md, 2026-11-27 "issue
-  // 35, part 2", gives the error argument). A triangle whose three vertices share one
-  // coordinate exactly (x_k = P: a wall of a box) is tested without Embree's arithmetic:
-  // for it Embree's normal has exact zeros off axis k, so Embree's t is (P - o_k) / D_k up
-  // to a few roundings whatever its normal's own rounding, and the edge functions are a 2D
-  // test in the plane, bounded against exact arithmetic (Embree's and ours). k = -1: the
-  // triangle is not such a triangle (or out of the ranges the argument needs): Embree's
-  // formulas, as before.
-  struct alignas(64) AxisRow {
-    int32_t k = -1, i = 0, j = 0;  // normal axis, the two in-plane axes
-    float P = 0.0f;                // the plane x_k = P
-    float q0i = 0.0f, q0j = 0.0f;  // vertex v0's in-plane coordinates
-    // Edge functions of Y = X - v0 (X: where the ray meets the plane, in-plane axes i, j):
-    // f_e = n_e . Y (+ c1 for the edge v1 -> v2), twice the signed area of (edge, X),
-    // oriented so that f > 0 inside; f_0 + f_1 + f_2 = A (twice the area).
-    float n[3][2] = {};
-    float c1 = 0.0f;
-    float pad[3] = {};
+  // The axis-plane test (tiny_x8.h; docs/notes/cpu-log.md, 2026-11-27 "issue 35, part 2",
+  // gives the error argument). A triangle whose three vertices share one coordinate exactly
+  // (x_k = P: a wall of a box) is tested without Embree's arithmetic: for it Embree's
+  // normal has exact zeros off axis k, so Embree's t is (P - o_k) / D_k up to a few
+  // roundings whatever its normal's own rounding, and its edge functions are a 2D test in
+  // the plane, bounded here against exact arithmetic (Embree's error and ours). Two such
+  // triangles of one plane in a row (a quad's halves) form one group: one t and one
+  // in-plane point for both. Every other triangle (`general`) gets Embree's formulas, as
+  // before.
+  struct alignas(64) AxisGroup {
+    int32_t k, i, j, count;  // normal axis, the two in-plane axes; 1 or 2 triangles
+    float P, Ri, Rj;         // the plane x_k = P; a vertex R of the group (in-plane i, j)
+    uint32_t id[2];          // scene triangles
+    // Per triangle and edge: f = n_i Y_i + n_j Y_j + c, Y = X - R (X: where the ray meets
+    // the plane), twice the signed area of (edge, X), oriented so that f > 0 inside.
+    float e[2][3][3];
+    float pad[5];
   };
-  static_assert(sizeof(AxisRow) == 64);
-  std::vector<AxisRow> axis;  // one per triangle
-  bool any_axis = false;
-  float axis_e = 0.0f;        // largest |edge component| of the axis-plane triangles
-  float axis_m_ok = 0.0f;     // a ray uses the axis-plane test only where M <= this (min 2^14 A / E)
+  static_assert(sizeof(AxisGroup) == 128);
+  std::vector<AxisGroup> groups;
+  std::vector<uint32_t> general;  // the other rows of `triangles`
+  float axis_e = 0.0f;     // largest |edge component| of the grouped triangles
+  float axis_m_ok = 0.0f;  // a ray uses the axis-plane test only where M <= this (min 2^14 A / E)
 
-  // The axis-plane row of r, where r qualifies (the ranges the error argument needs:
+  // A triangle in a plane x_k = P, where it qualifies (the ranges the error argument needs:
   // coordinates at most 2^20, P zero or at least 2^-20, A in [2^-20, 2^40], no sliver:
   // A >= 2^-19 E^2).
-  static AxisRow axis_row(const Triangle& r, double& e_out, double& m_ok_out) {
-    AxisRow a;
+  struct AxisTri {
+    int k = -1, i = 0, j = 0;
+    double P = 0.0, q[3][2] = {}, sg = 1.0, A = 0.0, E = 0.0;
+  };
+  static AxisTri axis_tri(const Triangle& r) {
+    AxisTri a;
     int k = -1;
     for (int c = 0; c < 3; ++c)
       if (r.p[c] == r.p[3 + c] && r.p[c] == r.p[6 + c]) k = (k == -1 ? c : 3);
@@ -90,31 +93,67 @@ struct TinyScene {
     const double P = r.p[k];
     if (P != 0.0 && std::fabs(P) < 0x1p-20) return a;
     const int i = (k + 1) % 3, j = (k + 2) % 3;
-    double q[3][2];
-    for (int v = 0; v < 3; ++v) q[v][0] = r.p[3 * v + i], q[v][1] = r.p[3 * v + j];
-    auto cross2 = [](double ai, double aj, double bi, double bj) { return ai * bj - aj * bi; };
-    const double area2 = cross2(q[1][0] - q[0][0], q[1][1] - q[0][1], q[2][0] - q[0][0], q[2][1] - q[0][1]);
-    const double A = std::fabs(area2);
-    double E = 0.0;
+    for (int v = 0; v < 3; ++v) a.q[v][0] = r.p[3 * v + i], a.q[v][1] = r.p[3 * v + j];
+    const double area2 = (a.q[1][0] - a.q[0][0]) * (a.q[2][1] - a.q[0][1]) - (a.q[1][1] - a.q[0][1]) * (a.q[2][0] - a.q[0][0]);
+    a.A = std::fabs(area2);
     for (int v = 0; v < 3; ++v)
-      for (int c = 0; c < 2; ++c) E = std::max(E, std::fabs(q[(v + 1) % 3][c] - q[v][c]));
-    if (!(A >= 0x1p-20 && A <= 0x1p40 && A >= 0x1p-19 * E * E)) return a;
-    const double sg = area2 > 0.0 ? 1.0 : -1.0;
-    // Edge a -> b: f = sg cross2(b - a, X - a) = sg ((b - a)_i Y_j - (b - a)_j Y_i) + c.
-    const int from[3] = {0, 1, 2}, to[3] = {1, 2, 0};
-    for (int e = 0; e < 3; ++e) {
-      const double di = q[to[e]][0] - q[from[e]][0], dj = q[to[e]][1] - q[from[e]][1];
-      a.n[e][0] = float(-sg * dj);
-      a.n[e][1] = float(sg * di);
-    }
-    // Edge 1 -> 2 does not pass through v0: c1 = -sg cross2(q2 - q1, q1 - q0).
-    a.c1 = float(-sg * cross2(q[2][0] - q[1][0], q[2][1] - q[1][1], q[1][0] - q[0][0], q[1][1] - q[0][1]));
-    a.k = k, a.i = i, a.j = j;
-    a.P = float(P);
-    a.q0i = float(q[0][0]), a.q0j = float(q[0][1]);
-    e_out = E;
-    m_ok_out = 0x1p14 * A / E;
+      for (int c = 0; c < 2; ++c) a.E = std::max(a.E, std::fabs(a.q[(v + 1) % 3][c] - a.q[v][c]));
+    if (!(a.A >= 0x1p-20 && a.A <= 0x1p40 && a.A >= 0x1p-19 * a.E * a.E)) return a;
+    a.sg = area2 > 0.0 ? 1.0 : -1.0;
+    a.k = k, a.i = i, a.j = j, a.P = P;
     return a;
+  }
+  // Triangle t's edges relative to R into g.e[h]: edge a -> b: n = sg (-(b - a)_j, (b - a)_i),
+  // c = n . (R - a), in double, rounded once.
+  static void set_edges(AxisGroup& g, int h, const AxisTri& t, double Ri, double Rj) {
+    for (int e = 0; e < 3; ++e) {
+      const double* a = t.q[e];
+      const double* b = t.q[(e + 1) % 3];
+      const double ni = -t.sg * (b[1] - a[1]), nj = t.sg * (b[0] - a[0]);
+      g.e[h][e][0] = float(ni);
+      g.e[h][e][1] = float(nj);
+      g.e[h][e][2] = float(ni * (Ri - a[0]) + nj * (Rj - a[1]));
+    }
+  }
+  // The groups and the general rows of the table.
+  void set_axis_groups() {
+    std::vector<AxisTri> at;
+    for (const Triangle& r : triangles) at.push_back(axis_tri(r));
+    double e_max = 0.0, m_ok = 0x1p100;
+    for (const AxisTri& a : at)
+      if (a.k >= 0) e_max = std::max(e_max, a.E), m_ok = std::min(m_ok, 0x1p14 * a.A / a.E);
+    for (size_t r = 0; r < triangles.size(); ++r) {
+      const AxisTri& a = at[r];
+      if (a.k < 0) {
+        general.push_back(uint32_t(r));
+        continue;
+      }
+      AxisGroup g{};
+      g.k = a.k, g.i = a.i, g.j = a.j, g.P = float(a.P);
+      g.Ri = float(a.q[0][0]), g.Rj = float(a.q[0][1]);
+      g.count = 1;
+      g.id[0] = g.id[1] = triangles[r].triangle;
+      set_edges(g, 0, a, a.q[0][0], a.q[0][1]);
+      // The next row in the same plane joins when its vertices lie within 2 E of R (the
+      // error argument's bound on |vertex - R|).
+      if (r + 1 < triangles.size()) {
+        const AxisTri& b = at[r + 1];
+        bool near = b.k == a.k && b.P == a.P;
+        for (int v = 0; v < 3 && near; ++v)
+          near = std::fabs(b.q[v][0] - a.q[0][0]) <= 2.0 * e_max && std::fabs(b.q[v][1] - a.q[0][1]) <= 2.0 * e_max;
+        if (near) {
+          g.count = 2;
+          g.id[1] = triangles[r + 1].triangle;
+          set_edges(g, 1, b, a.q[0][0], a.q[0][1]);
+          ++r;
+        }
+      }
+      groups.push_back(g);
+    }
+    if (!groups.empty()) {
+      axis_e = std::nextafter(float(e_max), __builtin_inff());  // rounded up
+      axis_m_ok = std::nextafter(float(m_ok), 0.0f);            // rounded down
+    }
   }
 
   // r's plane in double, rounded to float; a degenerate triangle is never culled.
@@ -174,19 +213,7 @@ struct TinyScene {
     t->pmax = 0.0f;
     for (int j = 0; j < 3; ++j) t->pmax = std::max({t->pmax, std::fabs(t->lo[j]), std::fabs(t->hi[j])});
     for (Triangle& r : t->triangles) set_plane(r, t->pmax);
-    double axis_e = 0.0, axis_m_ok = 0x1p100;
-    for (const Triangle& r : t->triangles) {
-      double e = 0.0, m_ok = 0.0;
-      t->axis.push_back(axis_row(r, e, m_ok));
-      if (t->axis.back().k < 0) continue;
-      t->any_axis = true;
-      axis_e = std::max(axis_e, e);
-      axis_m_ok = std::min(axis_m_ok, m_ok);
-    }
-    if (t->any_axis) {
-      t->axis_e = std::nextafter(float(axis_e), __builtin_inff());  // rounded up
-      t->axis_m_ok = std::nextafter(float(axis_m_ok), 0.0f);         // rounded down
-    }
+    t->set_axis_groups();
     return t;
   }
 };

@@ -66,19 +66,19 @@ struct TinyResult {
   UV id;             // scene triangle of `best`
 };
 
-// One triangle's verdict for each lane: a proven hit at t (Embree's t within err), proven
-// irrelevant (`away`: Embree rejects it, or it lies beyond the lane's proven hit), or
-// neither (a doubt: at t - err where `known`, else anywhere from 0).
-struct Candidate {
-  IV proven, away, known;
-  FV t, err;
-};
+// A table value in every lane: one broadcast (splat adds +0.0f, which the compiler must
+// keep for -0.0; no sign of zero matters to the axis-plane test).
+#if PB_SIMD_LANES == 16
+inline FV bcast(const float& x) { return FV(_mm512_set1_ps(x)); }
+#else
+inline FV bcast(const float& x) { return FV(_mm256_set1_ps(x)); }
+#endif
 
-// The axis-plane test's per-ray data (tiny_scene.h AxisRow; docs/notes/cpu-log.md gives the
-// argument). Per axis c: 1 / D_c; the edge margin's factors (m = G a_c + b_c, G = |X - v0|
-// in the plane); whether a lane may use it for a triangle of normal axis c (`ok`: its
-// origin and D_c in the ranges the argument needs, M <= the scene's axis_m_ok); D_c == 0
-// (Embree's den is 0: it rejects every such triangle).
+// The axis-plane test's per-ray data (tiny_scene.h AxisGroup; docs/notes/cpu-log.md gives
+// the argument). Per axis c: 1 / D_c; the edge margin's factors (m = G a_c + b_c, G =
+// |X - R|_inf in the plane); whether a lane may use the test for a plane of normal axis c
+// (`ok`: its origin and D_c in the ranges the argument needs, M <= the scene's
+// axis_m_ok); D_c == 0 (Embree's den is 0: it rejects every such triangle).
 struct AxisRays {
   FV inv_d[3], ma[3], mb[3];
   IV ok[3], d_zero[3];
@@ -87,16 +87,15 @@ struct AxisRays {
 
 inline IV in_range(FV a, float lo, float hi) { return (a >= lo) & (a <= hi); }
 
-inline AxisRays axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV m_bound, FV d1, FV tnear, FV tfar) {
-  AxisRays a;
+inline void axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV m_bound, FV d1, FV tnear, FV tfar, AxisRays& a) {
   IV base = m_bound <= s.axis_m_ok;
   for (int c = 0; c < 3; ++c) base &= (oc[c] == 0.0f) | in_range(abs(oc[c]), 0x1p-20f, 0x1p20f);
   // Embree's error against exact arithmetic (vertex rounding and its formula), plus its
-  // tolerance and our error, in units of our edge functions: u K (6 M G + 17 E G + 26 E M
-  // + 13 E^2), K = |D|_1 / |D_c|, u = 2^-24 (the entry's derivation); times 3.
+  // tolerance and our error, in units of our edge functions: u K (6 M G + 17 E G + 32 E M
+  // + 22 E^2), K = |D|_1 / |D_c|, u = 2^-24 (the entry's derivation); times 3.
   const float E = s.axis_e;
   const FV a_c = 0x1p-24f * madd(18.0f, m_bound, splat(51.0f * E));
-  const FV b_c = 0x1p-24f * E * madd(78.0f, m_bound, splat(39.0f * E));
+  const FV b_c = (0x1p-24f * E) * madd(96.0f, m_bound, splat(66.0f * E));
   for (int c = 0; c < 3; ++c) {
     a.inv_d[c] = 1.0f / dc[c];
     const FV K = d1 * abs(a.inv_d[c]);
@@ -110,38 +109,125 @@ inline AxisRays axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV m_b
   a.tn_behind = tnear * (1.0f - 0x1p-18f);
   a.tf_before = tfar * (1.0f - 0x1p-18f);
   a.tf_beyond = tfar * (1.0f + 0x1p-18f);
-  return a;
 }
 
-// The axis-plane test of row `ar` (ar.k >= 0) for every lane. `skip`: lanes that need no
-// answer from it (blocked already, or a proven hit nearer than `best_hi`); returns false
-// where every lane is away or skipped (nothing to do).
-inline bool axis_candidate(const TinyScene::AxisRow& ar, const AxisRays& a, const FV* oc, const FV* dc, IV skip,
-                           FV best_hi, Candidate& cand) {
-  const int k = ar.k;
-  const FV t = (splat(ar.P) - oc[k]) * a.inv_d[k];  // P - o_k: Embree's own first operation
-  const IV ok = a.ok[k];
-  const IV front = t > a.tn_front, before = t < a.tf_before;
-  const IV behind = t < a.tn_behind, beyond = t > a.tf_beyond;
-  // Beyond the lane's proven hit (and its interval): can neither win nor make it unsure.
-  const IV far = t * (1.0f - 0x1p-18f) > best_hi;
-  IV away = a.d_zero[k] | (ok & (behind | beyond | far));
-  if (lane_mask(~(away | skip)) == 0) return false;
-  const int i = ar.i, j = ar.j;
-  const FV yi = madd_v(t, dc[i], oc[i] - ar.q0i), yj = madd_v(t, dc[j], oc[j] - ar.q0j);
-  const FV f0 = madd_v(splat(ar.n[0][0]), yi, ar.n[0][1] * yj);
-  const FV f1 = madd_v(splat(ar.n[1][0]), yi, madd_v(splat(ar.n[1][1]), yj, splat(ar.c1)));
-  const FV f2 = madd_v(splat(ar.n[2][0]), yi, ar.n[2][1] * yj);
-  const FV m = madd_v(vmax(abs(yi), abs(yj)), a.ma[k], a.mb[k]);
-  const FV lo = vmin(vmin(f0, f1), f2), hi = vmax(vmax(f0, f1), f2);
-  const IV inside = lo > m, outside = (lo < -m) & (hi > m);
-  away |= ok & outside;
-  cand.proven = ok & inside & front & before & ~away;
-  cand.away = away;
-  cand.known = ok & front;
-  cand.t = t;
-  cand.err = abs(t) * 0x1p-19f;  // 2.9x the bound
-  return true;
+// The closest-hit bookkeeping of one candidate (a triangle, or a group's two halves at
+// one t): `proven` a hit at t (Embree's t within err), `doubt` neither proven nor
+// irrelevant (at t - err where `known`, else anywhere from 0).
+template <bool AnyHit>
+inline void tiny_update(TinyResult& r, IV proven, IV doubt, FV t, FV err, IV known, UV id) {
+  if constexpr (AnyHit) {
+    r.best = select(proven, t, r.best);
+    r.other_lo = select(doubt, splat(0.0f), r.other_lo);
+    return;
+  }
+  const FV doubt_lo = select(known, t - err, splat(0.0f));
+  const IV nearer = proven & (t < r.best);
+  r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best - r.best_err, t - err)), r.other_lo);
+  r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
+  r.best = select(nearer, t, r.best);
+  r.best_err = select(nearer, err, r.best_err);
+  r.id = nearer ? id : r.id;
+}
+
+// The general triangles (tiny_scene.h `general`): Embree's robust Pluecker test operation
+// for operation, with margins (the header comment above).
+template <bool AnyHit>
+inline void general_test(const TinyScene& s, V3 o, V3 d, FV tfar, FV m_bound, FV d1, FV omax, FV dmx, FV tnear,
+                         TinyResult& r) {
+  const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
+  const FV inf = splat(__builtin_inff());
+  const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
+  const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
+  const FV tnear_lo = tnear * (1.0f - 0x1p-20f), tnear_hi = tnear * (1.0f + 0x1p-20f);
+  // The plane cull's scale (below): |o|_inf + t_end |d|_inf + the scene's largest
+  // coordinate bounds |x| on the segment and |vertex - x|. Shadow rays: t_end = tfar
+  // (inf: never culled). Closest hits: once every lane has a proven hit, t_end = its far
+  // end, best + err: a triangle the segment misses is farther than the hit in Embree's
+  // arithmetic too, and clear of its interval.
+  const FV dmax = dmx;
+  const FV cull_base = omax + s.pmax;
+  const FV shadow_scale = madd_v(tfar, dmax, cull_base);
+  for (const uint32_t row : s.general) {
+    const TinyScene::Triangle& tr = s.triangles[row];
+    if constexpr (AnyHit) {
+      // Skipped where every lane is away or blocked already.
+      if (lane_mask(~plane_away(tr, o, d, tfar, shadow_scale) & (r.best == inf)) == 0) continue;
+    } else if (lane_mask(r.best == inf) == 0) {
+      const FV t_end = r.best + r.best_err;
+      if (lane_mask(~plane_away(tr, o, d, t_end, madd_v(t_end, dmax, cull_base))) == 0) continue;
+    }
+    const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
+    const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
+    const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
+    const V3 e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
+    // The edge functions and the depth, in the order that lets the most triangles go
+    // early: for shadow rays the depth first (every wall of a closed box is crossed
+    // behind the origin or beyond tfar), for closest hits the edges first.
+    struct Edges {
+      IV outside, inside_any;  // inside_any: inside, before the grazing test
+    };
+    auto edges = [&] {
+      const FV U = fdot(fcross(e0, v2 + v0), d);
+      const FV V = fdot(fcross(e1, v0 + v1), d);
+      const FV W = fdot(fcross(e2, v1 + v2), d);
+      const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
+      const FV m = m_scale * tr.edge;
+      return Edges{(hi > m) & (lo < -m), (lo > m) | (hi < -m)};
+    };
+    struct Depth {
+      FV abs_den, Ts, band, den_band;
+      IV grazing, front, before, away;
+    };
+    auto depth = [&] {
+      const V3 ng = emb_stable_normal(e0, e1, e2);
+      FV den = fdot(ng, d);
+      den = den + den;
+      FV T = fdot(v0, ng);
+      T = T + T;
+      Depth z;
+      z.abs_den = abs(den);
+      z.Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
+      // Same inputs, same operations as Embree 3.13's source: the same T and den. The
+      // bands are slack for rounding-order differences all the same: in the dots
+      // (relative to |v0| |Ng| for T, |Ng| |D| for den) and, for T, a normal that picked
+      // the other cross product (relative to E^2).
+      const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
+      const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
+      z.band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
+      z.den_band = 0x1p-20f * ng1 * d1;
+      z.grazing = z.abs_den <= 32.0f * z.den_band;  // den's sign and size in doubt
+      const FV tnear_slack = z.band + z.den_band * tnear;
+      z.front = z.Ts > z.abs_den * tnear_hi + tnear_slack;
+      const IV behind = z.Ts < z.abs_den * tnear_lo - tnear_slack;
+      const FV tfar_slack = z.band + z.den_band * tfar_finite;
+      z.before = z.Ts < z.abs_den * tfar_lo - tfar_slack;
+      const IV beyond = z.Ts > z.abs_den * tfar_hi + tfar_slack;
+      // den == 0: Embree rejects the triangle outright (a ray in its plane).
+      z.away = (z.abs_den == 0.0f) | (~z.grazing & (behind | beyond));
+      return z;
+    };
+    Edges ed;
+    Depth z;
+    if constexpr (AnyHit) {
+      z = depth();
+      if (lane_mask(~z.away) == 0) continue;
+      ed = edges();
+    } else {
+      ed = edges();
+      if (lane_mask(~ed.outside) == 0) continue;
+      z = depth();
+    }
+    const IV proven = ed.inside_any & ~z.grazing & z.front & z.before;
+    const IV doubt = ~proven & ~ed.outside & ~z.away;
+    const FV rcp = 1.0f / z.abs_den;
+    const FV t = z.Ts * rcp;
+    const FV err = (z.band + abs(t) * z.den_band) * rcp + 0x1p-20f * abs(t);
+    tiny_update<AnyHit>(r, proven, doubt, t, err, z.front & ~z.grazing, UV{} + tr.triangle);
+    if constexpr (AnyHit) {
+      if (lane_mask(r.best == inf) == 0) return;  // every ray blocked: doubts no longer matter
+    }
+  }
 }
 
 // Every triangle of `s` against the rays; `AnyHit` (occlusion): only whether a proven
@@ -157,128 +243,69 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   for (int j = 0; j < 3; ++j) m_bound = vmax(m_bound, vmax(abs(s.hi[j] - oc[j]), abs(oc[j] - s.lo[j])));
   m_bound = m_bound * (1.0f + 0x1p-20f);  // the rounding of vertex - origin
   const FV d1 = abs(d.x) + abs(d.y) + abs(d.z);
-  const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
   const FV inf = splat(__builtin_inff());
-  const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
-  const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
   // Embree's tnear for these rays (embree_rays.h: ray_t_min, watertight.h), in the same
-  // float operations, and its rounding band as tfar's.
+  // float operations.
   const FV omax = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)), dmx = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
   const FV tnear = select(dmx > 0.0f, 0x1p-21f * omax * (1.0f / dmx), splat(0.0f));
-  const FV tnear_lo = tnear * (1.0f - 0x1p-20f), tnear_hi = tnear * (1.0f + 0x1p-20f);
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
-  AxisRays ax;
-  if (s.any_axis) ax = axis_rays(s, oc, dc, m_bound, d1, tnear, tfar);
-  // The plane cull's scale (below): |o|_inf + t_end |d|_inf + the scene's largest
-  // coordinate bounds |x| on the segment and |vertex - x|. Shadow rays: t_end = tfar
-  // (inf: never culled). Closest hits: once every lane has a proven hit, t_end = its far
-  // end, best + err: a triangle the segment misses is farther than the hit in Embree's
-  // arithmetic too, and clear of its interval.
-  const FV dmax = dmx;
-  const FV cull_base = omax + s.pmax;
-  const FV shadow_scale = madd_v(tfar, dmax, cull_base);
-  const size_t count = s.triangles.size();
-  for (size_t index = 0; index < count; ++index) {
-    const TinyScene::Triangle& tr = s.triangles[index];
-    Candidate cand;
-    if (s.axis[index].k >= 0) {
-      // The axis-plane test: blocked lanes (shadow rays) need no answer; closest hits:
-      // a triangle beyond every lane's proven hit is skipped as the plane cull does.
-      const IV skip = AnyHit ? (r.best < inf) : IV{};
-      if (!axis_candidate(s.axis[index], ax, oc, dc, skip, AnyHit ? inf : r.best + r.best_err, cand)) continue;
-    } else {
+  if (!s.groups.empty()) {
+    AxisRays a;
+    axis_rays(s, oc, dc, m_bound, d1, tnear, tfar, a);
+    for (const TinyScene::AxisGroup& g : s.groups) {
+      const int k = g.k;
+      const FV t = (bcast(g.P) - oc[k]) * a.inv_d[k];  // P - o_k: Embree's own first operation
+      const IV ok = a.ok[k];
+      const IV front = t > a.tn_front, before = t < a.tf_before;
+      IV away = a.d_zero[k] | (ok & ((t < a.tn_behind) | (t > a.tf_beyond)));
+      IV done;
       if constexpr (AnyHit) {
-        // Skipped where every lane is away or blocked already.
-        if (lane_mask(~plane_away(tr, o, d, tfar, shadow_scale) & (r.best == inf)) == 0) continue;
-      } else if (lane_mask(r.best == inf) == 0) {
-        const FV t_end = r.best + r.best_err;
-        if (lane_mask(~plane_away(tr, o, d, t_end, madd_v(t_end, dmax, cull_base))) == 0) continue;
-      }
-      const V3 v0 = V3{splat(tr.p[0]), splat(tr.p[1]), splat(tr.p[2])} - o;
-      const V3 v1 = V3{splat(tr.p[3]), splat(tr.p[4]), splat(tr.p[5])} - o;
-      const V3 v2 = V3{splat(tr.p[6]), splat(tr.p[7]), splat(tr.p[8])} - o;
-      const V3 e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
-      // The edge functions and the depth, in the order that lets the most triangles go
-      // early: for shadow rays the depth first (every wall of a closed box is crossed
-      // behind the origin or beyond tfar), for closest hits the edges first.
-      struct Edges {
-        IV outside, inside_any;  // inside_any: inside, before the grazing test
-      };
-      auto edges = [&] {
-        const FV U = fdot(fcross(e0, v2 + v0), d);
-        const FV V = fdot(fcross(e1, v0 + v1), d);
-        const FV W = fdot(fcross(e2, v1 + v2), d);
-        const FV lo = vmin(vmin(U, V), W), hi = vmax(vmax(U, V), W);
-        const FV m = m_scale * tr.edge;
-        return Edges{(hi > m) & (lo < -m), (lo > m) | (hi < -m)};
-      };
-      struct Depth {
-        FV abs_den, Ts, band, den_band;
-        IV grazing, front, before, away;
-      };
-      auto depth = [&] {
-        const V3 ng = emb_stable_normal(e0, e1, e2);
-        FV den = fdot(ng, d);
-        den = den + den;
-        FV T = fdot(v0, ng);
-        T = T + T;
-        Depth z;
-        z.abs_den = abs(den);
-        z.Ts = from_bits(bits(T) ^ (bits(den) & int32_t(0x80000000u)));  // T with den's sign: t = Ts / |den|
-        // Same inputs, same operations as Embree 3.13's source: the same T and den. The
-        // bands are slack for rounding-order differences all the same: in the dots
-        // (relative to |v0| |Ng| for T, |Ng| |D| for den) and, for T, a normal that picked
-        // the other cross product (relative to E^2).
-        const FV ng1 = abs(ng.x) + abs(ng.y) + abs(ng.z);
-        const FV v0max = vmax(vmax(abs(v0.x), abs(v0.y)), abs(v0.z));
-        z.band = 0x1p-20f * v0max * (ng1 + 3.0f * tr.edge * tr.edge);
-        z.den_band = 0x1p-20f * ng1 * d1;
-        z.grazing = z.abs_den <= 32.0f * z.den_band;  // den's sign and size in doubt
-        const FV tnear_slack = z.band + z.den_band * tnear;
-        z.front = z.Ts > z.abs_den * tnear_hi + tnear_slack;
-        const IV behind = z.Ts < z.abs_den * tnear_lo - tnear_slack;
-        const FV tfar_slack = z.band + z.den_band * tfar_finite;
-        z.before = z.Ts < z.abs_den * tfar_lo - tfar_slack;
-        const IV beyond = z.Ts > z.abs_den * tfar_hi + tfar_slack;
-        // den == 0: Embree rejects the triangle outright (a ray in its plane).
-        z.away = (z.abs_den == 0.0f) | (~z.grazing & (behind | beyond));
-        return z;
-      };
-      Edges ed;
-      Depth z;
-      if constexpr (AnyHit) {
-        z = depth();
-        if (lane_mask(~z.away) == 0) continue;
-        ed = edges();
+        done = away | (r.best < inf);  // blocked lanes need no answer
       } else {
-        ed = edges();
-        if (lane_mask(~ed.outside) == 0) continue;
-        z = depth();
+        // Beyond the lane's proven hit and its interval: it can neither win nor make the
+        // lane unsure (as the plane cull below).
+        away |= ok & (t * (1.0f - 0x1p-18f) > r.best + r.best_err);
+        done = away;
       }
-      cand.proven = ed.inside_any & ~z.grazing & z.front & z.before;
-      cand.away = ed.outside | z.away;
-      cand.known = z.front & ~z.grazing;
-      const FV rcp = 1.0f / z.abs_den;
-      cand.t = z.Ts * rcp;
-      cand.err = (z.band + abs(cand.t) * z.den_band) * rcp + 0x1p-20f * abs(cand.t);
+      if (lane_mask(~done) == 0) continue;
+      const int i = g.i, j = g.j;
+      const FV yi = madd_v(t, dc[i], oc[i] - bcast(g.Ri)), yj = madd_v(t, dc[j], oc[j] - bcast(g.Rj));
+      const FV m = madd_v(vmax(abs(yi), abs(yj)), a.ma[k], a.mb[k]);
+      const IV hit_ok = ok & front & before & ~away;
+      // Triangle h of the group: proven hit, or away (rejected by Embree or beyond).
+      auto half = [&](int h, IV& proven, IV& away_h) {
+        const float(*e)[3] = g.e[h];
+        const FV f0 = madd_v(bcast(e[0][0]), yi, madd_v(bcast(e[0][1]), yj, bcast(e[0][2])));
+        const FV f1 = madd_v(bcast(e[1][0]), yi, madd_v(bcast(e[1][1]), yj, bcast(e[1][2])));
+        const FV f2 = madd_v(bcast(e[2][0]), yi, madd_v(bcast(e[2][1]), yj, bcast(e[2][2])));
+        const FV lo = vmin(vmin(f0, f1), f2), hi = vmax(vmax(f0, f1), f2);
+        proven = hit_ok & (lo > m);
+        away_h = away | (ok & (lo < -m) & (hi > m));
+      };
+      IV p0, a0;
+      half(0, p0, a0);
+      const FV err = abs(t) * 0x1p-19f;  // 2.9x the bound
+      const IV known = ok & front;
+      if (g.count == 1) {
+        tiny_update<AnyHit>(r, p0, ~p0 & ~a0, t, err, known, UV{} + g.id[0]);
+      } else {
+        IV p1, a1;
+        half(1, p1, a1);
+        if constexpr (AnyHit) {
+          tiny_update<AnyHit>(r, p0 | p1, (~p0 & ~a0) | (~p1 & ~a1), t, err, known, UV{});
+        } else {
+          // One candidate at t: a proven hit where one half is and the other is away; a
+          // doubt where neither is away and not exactly one proven.
+          const IV proven = (p0 & a1) | (p1 & a0);
+          tiny_update<AnyHit>(r, proven, ~proven & ~(a0 & a1), t, err, known, p0 ? UV{} + g.id[0] : UV{} + g.id[1]);
+        }
+      }
+      if constexpr (AnyHit) {
+        if (lane_mask(r.best == inf) == 0) return r;  // every ray blocked: doubts no longer matter
+      }
     }
-    const IV proven = cand.proven, doubt = ~proven & ~cand.away;
-    const FV t = cand.t, err = cand.err;
-    if constexpr (AnyHit) {
-      r.best = select(proven, t, r.best);
-      r.other_lo = select(doubt, splat(0.0f), r.other_lo);
-      if (lane_mask(r.best == inf) == 0) break;  // every ray blocked: doubts no longer matter
-      continue;
-    }
-    // A doubt's distance counts only where it is known (in front, not grazing); else 0.
-    const FV doubt_lo = select(cand.known, t - err, splat(0.0f));
-    const IV nearer = proven & (t < r.best);
-    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best - r.best_err, t - err)), r.other_lo);
-    r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
-    r.best = select(nearer, t, r.best);
-    r.best_err = select(nearer, err, r.best_err);
-    r.id = nearer ? UV{} + tr.triangle : r.id;
   }
+  if (!s.general.empty()) general_test<AnyHit>(s, o, d, tfar, m_bound, d1, omax, dmx, tnear, r);
   return r;
 }
 
