@@ -74,6 +74,7 @@ struct TinyScene {
   std::vector<uint32_t> general;  // the other rows of `triangles`
   float axis_e = 0.0f;     // largest |edge component| of the grouped triangles
   float axis_m_ok = 0.0f;  // a ray uses the axis-plane test only where M <= this (min 2^14 A / E)
+  float axis_o_ok = -1.0f; // ... checked as |o|_inf <= this (M <= |o|_inf + pmax)
 
   // A triangle in a plane x_k = P, where it qualifies (the ranges the error argument needs:
   // coordinates at most 2^20, P zero or at least 2^-20, A in [2^-20, 2^40], no sliver:
@@ -153,6 +154,7 @@ struct TinyScene {
     if (!groups.empty()) {
       axis_e = std::nextafter(float(e_max), __builtin_inff());  // rounded up
       axis_m_ok = std::nextafter(float(m_ok), 0.0f);            // rounded down
+      axis_o_ok = std::nextafter(float((m_ok - double(pmax)) * (1.0 - 0x1p-20)), -1.0f);
     }
   }
 

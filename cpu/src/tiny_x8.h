@@ -66,6 +66,13 @@ struct TinyResult {
   UV id;             // scene triangle of `best`
 };
 
+// kLanes floats from p (any alignment): one load.
+#if PB_SIMD_LANES == 16
+inline FV load_lanes(const float* p) { return FV(_mm512_loadu_ps(p)); }
+#else
+inline FV load_lanes(const float* p) { return FV(_mm256_loadu_ps(p)); }
+#endif
+
 // A table value in every lane: one broadcast (splat adds +0.0f, which the compiler must
 // keep for -0.0; no sign of zero matters to the axis-plane test).
 #if PB_SIMD_LANES == 16
@@ -87,20 +94,11 @@ struct AxisRays {
 
 inline IV in_range(FV a, float lo, float hi) { return (a >= lo) & (a <= hi); }
 
-inline void axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV m_bound, FV d1, FV tnear, FV tfar, AxisRays& a) {
-  IV base = m_bound <= s.axis_m_ok;
+inline void axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV omax, FV tnear, FV tfar, AxisRays& a) {
+  IV base = omax <= s.axis_o_ok;  // M <= |o|_inf + pmax <= axis_m_ok
   for (int c = 0; c < 3; ++c) base &= (oc[c] == 0.0f) | in_range(abs(oc[c]), 0x1p-20f, 0x1p20f);
-  // Embree's error against exact arithmetic (vertex rounding and its formula), plus its
-  // tolerance and our error, in units of our edge functions: u K (6 M G + 17 E G + 32 E M
-  // + 22 E^2), K = |D|_1 / |D_c|, u = 2^-24 (the entry's derivation); times 3.
-  const float E = s.axis_e;
-  const FV a_c = 0x1p-24f * madd(18.0f, m_bound, splat(51.0f * E));
-  const FV b_c = (0x1p-24f * E) * madd(96.0f, m_bound, splat(66.0f * E));
   for (int c = 0; c < 3; ++c) {
     a.inv_d[c] = 1.0f / dc[c];
-    const FV K = d1 * abs(a.inv_d[c]);
-    a.ma[c] = K * a_c;
-    a.mb[c] = K * b_c;
     a.ok[c] = base & in_range(abs(dc[c]), 0x1p-20f, 0x1p20f);
     a.d_zero[c] = base & (dc[c] == 0.0f);
   }
@@ -109,6 +107,21 @@ inline void axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV m_bound
   a.tn_behind = tnear * (1.0f - 0x1p-18f);
   a.tf_before = tfar * (1.0f - 0x1p-18f);
   a.tf_beyond = tfar * (1.0f + 0x1p-18f);
+}
+// The edge margins' factors, computed where a first edge test is needed (shadow rays
+// seldom need one).
+inline void axis_margins(const TinyScene& s, FV m_bound, FV d1, AxisRays& a) {
+  // Embree's error against exact arithmetic (vertex rounding and its formula), plus its
+  // tolerance and our error, in units of our edge functions: u K (6 M G + 17 E G + 32 E M
+  // + 22 E^2), K = |D|_1 / |D_c|, u = 2^-24 (the entry's derivation); times 3.
+  const float E = s.axis_e;
+  const FV a_c = 0x1p-24f * madd(18.0f, m_bound, splat(51.0f * E));
+  const FV b_c = (0x1p-24f * E) * madd(96.0f, m_bound, splat(66.0f * E));
+  for (int c = 0; c < 3; ++c) {
+    const FV K = d1 * abs(a.inv_d[c]);
+    a.ma[c] = K * a_c;
+    a.mb[c] = K * b_c;
+  }
 }
 
 // The closest-hit bookkeeping of one candidate (a triangle, or a group's two halves at
@@ -235,13 +248,17 @@ inline void general_test(const TinyScene& s, V3 o, V3 d, FV tfar, FV m_bound, FV
 template <bool AnyHit>
 inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in) {
   FV c[6], tfar;
-  for (int j = 0; j < 6; ++j) std::memcpy(&c[j], rays[j], sizeof(FV));
-  std::memcpy(&tfar, tfar_in, sizeof tfar);
+  for (int j = 0; j < 6; ++j) c[j] = load_lanes(rays[j]);
+  tfar = load_lanes(tfar_in);
   const V3 o{c[0], c[1], c[2]}, d{c[3], c[4], c[5]};
   const FV oc[3] = {o.x, o.y, o.z}, dc[3] = {d.x, d.y, d.z};
-  FV m_bound = splat(0.0f);
-  for (int j = 0; j < 3; ++j) m_bound = vmax(m_bound, vmax(abs(s.hi[j] - oc[j]), abs(oc[j] - s.lo[j])));
-  m_bound = m_bound * (1.0f + 0x1p-20f);  // the rounding of vertex - origin
+  // M: a bound on |vertex - origin| (every component, every vertex), with its rounding;
+  // only where the margins need it.
+  auto m_bound_of = [&] {
+    FV m = splat(0.0f);
+    for (int j = 0; j < 3; ++j) m = vmax(m, vmax(abs(s.hi[j] - oc[j]), abs(oc[j] - s.lo[j])));
+    return m * (1.0f + 0x1p-20f);
+  };
   const FV d1 = abs(d.x) + abs(d.y) + abs(d.z);
   const FV inf = splat(__builtin_inff());
   // Embree's tnear for these rays (embree_rays.h: ray_t_min, watertight.h), in the same
@@ -251,7 +268,8 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
   TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   if (!s.groups.empty()) {
     AxisRays a;
-    axis_rays(s, oc, dc, m_bound, d1, tnear, tfar, a);
+    axis_rays(s, oc, dc, omax, tnear, tfar, a);
+    bool margins = false;
     for (const TinyScene::AxisGroup& g : s.groups) {
       const int k = g.k;
       const FV t = (bcast(g.P) - oc[k]) * a.inv_d[k];  // P - o_k: Embree's own first operation
@@ -268,6 +286,10 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
         done = away;
       }
       if (lane_mask(~done) == 0) continue;
+      if (!margins) {
+        axis_margins(s, m_bound_of(), d1, a);
+        margins = true;
+      }
       const int i = g.i, j = g.j;
       const FV yi = madd_v(t, dc[i], oc[i] - bcast(g.Ri)), yj = madd_v(t, dc[j], oc[j] - bcast(g.Rj));
       const FV m = madd_v(vmax(abs(yi), abs(yj)), a.ma[k], a.mb[k]);
@@ -305,7 +327,7 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
       }
     }
   }
-  if (!s.general.empty()) general_test<AnyHit>(s, o, d, tfar, m_bound, d1, omax, dmx, tnear, r);
+  if (!s.general.empty()) general_test<AnyHit>(s, o, d, tfar, m_bound_of(), d1, omax, dmx, tnear, r);
   return r;
 }
 
@@ -320,7 +342,8 @@ inline uint32_t tiny_occluded(const TinyScene& s, const float* const* rays, cons
   const TinyResult r = tiny_test<true>(s, rays, tfar);
   const FV inf = splat(__builtin_inff());
   const IV hit = r.best < inf;
-  for (int i = 0; i < kLanes; ++i) blocked[i] = hit[i] != 0;
+  const uint32_t m = lane_mask(hit);
+  for (int i = 0; i < kLanes; ++i) blocked[i] = (m >> i) & 1;
   return lane_mask(~hit & (r.other_lo < inf));
 }
 
