@@ -31,10 +31,14 @@
 namespace pb::cpu {
 
 struct TinyScene {
-  // Above 3 triangles per lane (as Embree sees them: 24 with AVX2, 48 with AVX-512)
-  // Embree's BVH is cheaper than testing them all (AVX2 measured between 14 and 34
-  // triangles; AVX-512, whose test costs half per ray, estimated: docs/notes/cpu-log.md).
+  // Above a weight of 3 per lane (24 with AVX2, 48 with AVX-512) Embree's BVH is cheaper
+  // than testing every triangle. The weight: one per general triangle (as Embree sees them;
+  // AVX2 measured between 14 and 34, AVX-512, whose test costs half per ray, estimated),
+  // one half per axis-plane group (AVX2, pixel, callgrind: 19 and 31 groups 0.65x Embree's
+  // instructions, 55 groups 0.97x; cornell-box 0.69x, paper-cornell-ico:0 0.64x, ico:1 2.2x;
+  // docs/notes/cpu-log.md, 2026-11-27, part 2).
   static constexpr int kTrianglesPerLane = 3;
+  size_t weight() const { return general.size() + (groups.size() + 1) / 2; }
   struct alignas(64) Triangle {
     float p[9];         // vertices v0, v1, v2 in Embree's order
     uint32_t triangle;  // the scene triangle
@@ -176,12 +180,15 @@ struct TinyScene {
     r.cull_k = float(0x1p-15 * (1.0 + 2.0 * double(r.edge) * double(r.edge) / len) + (2.0 * rho + 0x1p-30) / pmax);
   }
 
-  // The table for the Embree scene `e` of `s`, or null where it has more than
-  // `max_triangles`.
+  // The table for the Embree scene `e` of `s`, or null where its weight is above
+  // `max_weight`.
   // Quads are split as Embree splits them: (v0, v1, v3), then (v2, v3, v1); the empty
   // second half of a lone triangle's quad (a, b, c, c) is left out (Embree never hits it:
   // its normal is zero).
-  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s, size_t max_triangles) {
+  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s, size_t max_weight) {
+    // At most 4 triangles (two groups of two) a unit of weight: larger scenes are never built.
+    const TrianglePairs* pairs = e.pairs();
+    if ((pairs ? 2 * pairs->quads.size() : size_t(s.num_triangles)) > 4 * max_weight + 1) return nullptr;
     auto t = std::make_unique<TinyScene>();
     auto add = [&](uint32_t a, uint32_t b, uint32_t c, uint32_t tri) {
       Triangle r;
@@ -194,7 +201,7 @@ struct TinyScene {
         for (int j = 0; j < 3; ++j) r.edge = std::max(r.edge, std::fabs(v[(i + 1) % 3][j] - v[i][j]));
       t->triangles.push_back(r);
     };
-    if (const TrianglePairs* pairs = e.pairs()) {
+    if (pairs) {
       for (size_t q = 0; q < pairs->quads.size(); ++q) {
         const auto& v = pairs->quads[q];
         add(v[0], v[1], v[3], pairs->triangle[2 * q]);
@@ -203,7 +210,7 @@ struct TinyScene {
     } else {
       for (uint32_t i = 0; i < s.num_triangles; ++i) add(s.triangles[i].v[0], s.triangles[i].v[1], s.triangles[i].v[2], i);
     }
-    if (t->triangles.empty() || t->triangles.size() > max_triangles) return nullptr;
+    if (t->triangles.empty()) return nullptr;
     for (int j = 0; j < 3; ++j) {
       t->lo[j] = t->hi[j] = t->triangles[0].p[j];
       for (const Triangle& r : t->triangles)
@@ -216,12 +223,13 @@ struct TinyScene {
     for (int j = 0; j < 3; ++j) t->pmax = std::max({t->pmax, std::fabs(t->lo[j]), std::fabs(t->hi[j])});
     for (Triangle& r : t->triangles) set_plane(r, t->pmax);
     t->set_axis_groups();
+    if (t->weight() > max_weight) return nullptr;
     return t;
   }
 };
 
 // The tiny test where it applies: batched kernels `k` (a vector ISA; AVX2 needs FMA too,
-// as Embree's AVX2 kernels do) and a scene of at most kTrianglesPerLane per lane;
+// as Embree's AVX2 kernels do) and a scene of weight at most kTrianglesPerLane per lane;
 // otherwise null.
 inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const SceneView& s, const BatchKernels* k) {
   if (!k || !__builtin_cpu_supports("fma")) return nullptr;

@@ -266,9 +266,11 @@ TEST(TinyScene, OnlyForTinyScenes) {
   EXPECT_EQ(cpu::TinyScene::build(*embree, big.view(), 64), nullptr);
   const Scene box = load_scene("paper-cornell");
   const auto quads = cpu::make_embree_scene(box, true, EmbreeLayout::Quads);
-  EXPECT_EQ(cpu::TinyScene::build(*quads, box.view(), 13), nullptr);  // 14 halves
-  const auto t = cpu::TinyScene::build(*quads, box.view(), 14);
+  // 14 halves in 7 axis-plane groups: weight 4 (a group counts half a general triangle).
+  EXPECT_EQ(cpu::TinyScene::build(*quads, box.view(), 3), nullptr);
+  const auto t = cpu::TinyScene::build(*quads, box.view(), 4);
   ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->weight(), 4u);
   EXPECT_EQ(t->triangles.size(), box.triangles.size());  // every quad's two halves
 }
 
@@ -277,7 +279,7 @@ TEST(TinyScene, OnlyForTinyScenes) {
 TEST(TinyScene, AxisPlaneGroups) {
   const Scene box = load_scene("paper-cornell");
   const auto quads = cpu::make_embree_scene(box, true, EmbreeLayout::Quads);
-  const auto t = cpu::TinyScene::build(*quads, box.view(), 14);
+  const auto t = cpu::TinyScene::build(*quads, box.view(), 4);
   ASSERT_NE(t, nullptr);
   EXPECT_EQ(t->groups.size(), 7u);
   EXPECT_TRUE(t->general.empty());
