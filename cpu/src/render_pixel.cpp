@@ -35,11 +35,12 @@ namespace {
 // Xeon); at 64 a thread, ~1% (docs/notes/cpu-log.md, 2026-11-27).
 constexpr uint32_t kTile = 8;
 // The final vertex's shadow rays go through the tiny test only where a batch has at least this
-// many: a tiny test costs about a full packet whatever its fill (~2,300 instructions at 8 lanes,
-// ~400 ns at 16 on the Xeon), one rtcOccluded1 ~800 instructions (~80-100 ns); a batch's last
-// vertex mostly has 0-2 (callgrind: tiny test for every one, 1681 instructions a sample against
-// 1653 with single rays only).
-constexpr int kTinyFinalMin = 4;
+// many. With the tiny test of 2026-11-24 (~2,300 instructions a packet of 8, what a scene of
+// general triangles still costs) 4 paid against one rtcOccluded1 a ray (~800); the axis-plane
+// test answers a box's shadow packet in ~400 (docs/notes/cpu-log.md, 2026-11-27, part 2), so
+// there one ray already pays: callgrind, pixel, quads, --isa avx2, 64x64x16: 1050.8
+// instructions a sample with 4, 1046.0 with 1.
+int tiny_final_min(const TinyScene& t) { return t.general.empty() ? 1 : 4; }
 
 struct Local {
   RayCounts rays;
@@ -135,7 +136,7 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
       bool candidate[W];
       k.final_vertex_candidates(job.scene, at_final, candidate);
       // The emitter queries' shadow rays: one tiny test for all of them where there is one
-      // and they are enough to pay for it (kTinyFinalMin; a proven answer is Embree's), each
+      // and they are enough to pay for it (tiny_final_min; a proven answer is Embree's), each
       // unsure one (and every one otherwise) through the single-ray rtcOccluded1 this step
       // always made, so every ray gets the answer it got before (docs/notes/cpu-log.md,
       // 2026-11-27).
@@ -153,7 +154,7 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
         (depth == 0 ? local.rays.camera : local.rays.shadow) += uint64_t(n_q);  // count_ray, per query
         bool blocked[W];
         uint32_t unsure = (uint32_t(1) << n_q) - 1;
-        if (tiny && n_q >= kTinyFinalMin) {
+        if (tiny && n_q >= tiny_final_min(*tiny)) {
           PB_STAGE(kShadow);
           float* rays[6];
           packet_arrays(packets.shadow, rays);

@@ -31,10 +31,14 @@
 namespace pb::cpu {
 
 struct TinyScene {
-  // Above 3 triangles per lane (as Embree sees them: 24 with AVX2, 48 with AVX-512)
-  // Embree's BVH is cheaper than testing them all (AVX2 measured between 14 and 34
-  // triangles; AVX-512, whose test costs half per ray, estimated: docs/notes/cpu-log.md).
+  // Above a weight of 3 per lane (24 with AVX2, 48 with AVX-512) Embree's BVH is cheaper
+  // than testing every triangle. The weight: one per general triangle (as Embree sees them;
+  // AVX2 measured between 14 and 34, AVX-512, whose test costs half per ray, estimated),
+  // one half per axis-plane group (AVX2, pixel, callgrind: 19 and 31 groups 0.65x Embree's
+  // instructions, 55 groups 0.97x; cornell-box 0.69x, paper-cornell-ico:0 0.64x, ico:1 2.2x;
+  // docs/notes/cpu-log.md, 2026-11-27, part 2).
   static constexpr int kTrianglesPerLane = 3;
+  size_t weight() const { return general.size() + (groups.size() + 1) / 2; }
   struct alignas(64) Triangle {
     float p[9];         // vertices v0, v1, v2 in Embree's order
     uint32_t triangle;  // the scene triangle
@@ -50,6 +54,113 @@ struct TinyScene {
   std::vector<Triangle> triangles;
   float lo[3], hi[3];  // bounds of every vertex
   float pmax;          // largest |vertex coordinate| (the cull's scale)
+
+  // The axis-plane test (tiny_x8.h; docs/notes/cpu-log.md, 2026-11-27 "issue 35, part 2",
+  // gives the error argument). A triangle whose three vertices share one coordinate exactly
+  // (x_k = P: a wall of a box) is tested without Embree's arithmetic: for it Embree's
+  // normal has exact zeros off axis k, so Embree's t is (P - o_k) / D_k up to a few
+  // roundings whatever its normal's own rounding, and its edge functions are a 2D test in
+  // the plane, bounded here against exact arithmetic (Embree's error and ours). Two such
+  // triangles of one plane in a row (a quad's halves) form one group: one t and one
+  // in-plane point for both. Every other triangle (`general`) gets Embree's formulas, as
+  // before.
+  struct alignas(64) AxisGroup {
+    int32_t k, i, j, count;  // normal axis, the two in-plane axes; 1 or 2 triangles
+    float P, Ri, Rj;         // the plane x_k = P; a vertex R of the group (in-plane i, j)
+    uint32_t id[2];          // scene triangles
+    // Per triangle and edge: f = n_i Y_i + n_j Y_j + c, Y = X - R (X: where the ray meets
+    // the plane), twice the signed area of (edge, X), oriented so that f > 0 inside.
+    float e[2][3][3];
+    float pad[5];
+  };
+  static_assert(sizeof(AxisGroup) == 128);
+  std::vector<AxisGroup> groups;
+  std::vector<uint32_t> general;  // the other rows of `triangles`
+  float axis_e = 0.0f;     // largest |edge component| of the grouped triangles
+  float axis_m_ok = 0.0f;  // a ray uses the axis-plane test only where M <= this (min 2^14 A / E)
+  float axis_o_ok = -1.0f; // ... checked as |o|_inf <= this (M <= |o|_inf + pmax)
+
+  // A triangle in a plane x_k = P, where it qualifies (the ranges the error argument needs:
+  // coordinates at most 2^20, P zero or at least 2^-20, A in [2^-20, 2^40], no sliver:
+  // A >= 2^-19 E^2).
+  struct AxisTri {
+    int k = -1, i = 0, j = 0;
+    double P = 0.0, q[3][2] = {}, sg = 1.0, A = 0.0, E = 0.0;
+  };
+  static AxisTri axis_tri(const Triangle& r) {
+    AxisTri a;
+    int k = -1;
+    for (int c = 0; c < 3; ++c)
+      if (r.p[c] == r.p[3 + c] && r.p[c] == r.p[6 + c]) k = (k == -1 ? c : 3);
+    if (k < 0 || k > 2) return a;
+    for (float x : r.p)
+      if (!(std::fabs(x) <= 0x1p20f)) return a;
+    const double P = r.p[k];
+    if (P != 0.0 && std::fabs(P) < 0x1p-20) return a;
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    for (int v = 0; v < 3; ++v) a.q[v][0] = r.p[3 * v + i], a.q[v][1] = r.p[3 * v + j];
+    const double area2 = (a.q[1][0] - a.q[0][0]) * (a.q[2][1] - a.q[0][1]) - (a.q[1][1] - a.q[0][1]) * (a.q[2][0] - a.q[0][0]);
+    a.A = std::fabs(area2);
+    for (int v = 0; v < 3; ++v)
+      for (int c = 0; c < 2; ++c) a.E = std::max(a.E, std::fabs(a.q[(v + 1) % 3][c] - a.q[v][c]));
+    if (!(a.A >= 0x1p-20 && a.A <= 0x1p40 && a.A >= 0x1p-19 * a.E * a.E)) return a;
+    a.sg = area2 > 0.0 ? 1.0 : -1.0;
+    a.k = k, a.i = i, a.j = j, a.P = P;
+    return a;
+  }
+  // Triangle t's edges relative to R into g.e[h]: edge a -> b: n = sg (-(b - a)_j, (b - a)_i),
+  // c = n . (R - a), in double, rounded once.
+  static void set_edges(AxisGroup& g, int h, const AxisTri& t, double Ri, double Rj) {
+    for (int e = 0; e < 3; ++e) {
+      const double* a = t.q[e];
+      const double* b = t.q[(e + 1) % 3];
+      const double ni = -t.sg * (b[1] - a[1]), nj = t.sg * (b[0] - a[0]);
+      g.e[h][e][0] = float(ni);
+      g.e[h][e][1] = float(nj);
+      g.e[h][e][2] = float(ni * (Ri - a[0]) + nj * (Rj - a[1]));
+    }
+  }
+  // The groups and the general rows of the table.
+  void set_axis_groups() {
+    std::vector<AxisTri> at;
+    for (const Triangle& r : triangles) at.push_back(axis_tri(r));
+    double e_max = 0.0, m_ok = 0x1p100;
+    for (const AxisTri& a : at)
+      if (a.k >= 0) e_max = std::max(e_max, a.E), m_ok = std::min(m_ok, 0x1p14 * a.A / a.E);
+    for (size_t r = 0; r < triangles.size(); ++r) {
+      const AxisTri& a = at[r];
+      if (a.k < 0) {
+        general.push_back(uint32_t(r));
+        continue;
+      }
+      AxisGroup g{};
+      g.k = a.k, g.i = a.i, g.j = a.j, g.P = float(a.P);
+      g.Ri = float(a.q[0][0]), g.Rj = float(a.q[0][1]);
+      g.count = 1;
+      g.id[0] = g.id[1] = triangles[r].triangle;
+      set_edges(g, 0, a, a.q[0][0], a.q[0][1]);
+      // The next row in the same plane joins when its vertices lie within 2 E of R (the
+      // error argument's bound on |vertex - R|).
+      if (r + 1 < triangles.size()) {
+        const AxisTri& b = at[r + 1];
+        bool near = b.k == a.k && b.P == a.P;
+        for (int v = 0; v < 3 && near; ++v)
+          near = std::fabs(b.q[v][0] - a.q[0][0]) <= 2.0 * e_max && std::fabs(b.q[v][1] - a.q[0][1]) <= 2.0 * e_max;
+        if (near) {
+          g.count = 2;
+          g.id[1] = triangles[r + 1].triangle;
+          set_edges(g, 1, b, a.q[0][0], a.q[0][1]);
+          ++r;
+        }
+      }
+      groups.push_back(g);
+    }
+    if (!groups.empty()) {
+      axis_e = std::nextafter(float(e_max), __builtin_inff());  // rounded up
+      axis_m_ok = std::nextafter(float(m_ok), 0.0f);            // rounded down
+      axis_o_ok = std::nextafter(float((m_ok - double(pmax)) * (1.0 - 0x1p-20)), -1.0f);
+    }
+  }
 
   // r's plane in double, rounded to float; a degenerate triangle is never culled.
   static void set_plane(Triangle& r, double pmax) {
@@ -69,12 +180,15 @@ struct TinyScene {
     r.cull_k = float(0x1p-15 * (1.0 + 2.0 * double(r.edge) * double(r.edge) / len) + (2.0 * rho + 0x1p-30) / pmax);
   }
 
-  // The table for the Embree scene `e` of `s`, or null where it has more than
-  // `max_triangles`.
+  // The table for the Embree scene `e` of `s`, or null where its weight is above
+  // `max_weight`.
   // Quads are split as Embree splits them: (v0, v1, v3), then (v2, v3, v1); the empty
   // second half of a lone triangle's quad (a, b, c, c) is left out (Embree never hits it:
   // its normal is zero).
-  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s, size_t max_triangles) {
+  static std::unique_ptr<TinyScene> build(const EmbreeScene& e, const SceneView& s, size_t max_weight) {
+    // At most 4 triangles (two groups of two) a unit of weight: larger scenes are never built.
+    const TrianglePairs* pairs = e.pairs();
+    if ((pairs ? 2 * pairs->quads.size() : size_t(s.num_triangles)) > 4 * max_weight + 1) return nullptr;
     auto t = std::make_unique<TinyScene>();
     auto add = [&](uint32_t a, uint32_t b, uint32_t c, uint32_t tri) {
       Triangle r;
@@ -87,7 +201,7 @@ struct TinyScene {
         for (int j = 0; j < 3; ++j) r.edge = std::max(r.edge, std::fabs(v[(i + 1) % 3][j] - v[i][j]));
       t->triangles.push_back(r);
     };
-    if (const TrianglePairs* pairs = e.pairs()) {
+    if (pairs) {
       for (size_t q = 0; q < pairs->quads.size(); ++q) {
         const auto& v = pairs->quads[q];
         add(v[0], v[1], v[3], pairs->triangle[2 * q]);
@@ -96,7 +210,7 @@ struct TinyScene {
     } else {
       for (uint32_t i = 0; i < s.num_triangles; ++i) add(s.triangles[i].v[0], s.triangles[i].v[1], s.triangles[i].v[2], i);
     }
-    if (t->triangles.empty() || t->triangles.size() > max_triangles) return nullptr;
+    if (t->triangles.empty()) return nullptr;
     for (int j = 0; j < 3; ++j) {
       t->lo[j] = t->hi[j] = t->triangles[0].p[j];
       for (const Triangle& r : t->triangles)
@@ -108,12 +222,14 @@ struct TinyScene {
     t->pmax = 0.0f;
     for (int j = 0; j < 3; ++j) t->pmax = std::max({t->pmax, std::fabs(t->lo[j]), std::fabs(t->hi[j])});
     for (Triangle& r : t->triangles) set_plane(r, t->pmax);
+    t->set_axis_groups();
+    if (t->weight() > max_weight) return nullptr;
     return t;
   }
 };
 
 // The tiny test where it applies: batched kernels `k` (a vector ISA; AVX2 needs FMA too,
-// as Embree's AVX2 kernels do) and a scene of at most kTrianglesPerLane per lane;
+// as Embree's AVX2 kernels do) and a scene of weight at most kTrianglesPerLane per lane;
 // otherwise null.
 inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const SceneView& s, const BatchKernels* k) {
   if (!k || !__builtin_cpu_supports("fma")) return nullptr;

@@ -66,38 +66,103 @@ struct TinyResult {
   UV id;             // scene triangle of `best`
 };
 
-// Every triangle of `s` against the rays; `AnyHit` (occlusion): only whether a proven
-// hit exists, and stop once every lane has one.
+// kLanes floats from p (any alignment): one load.
+#if PB_SIMD_LANES == 16
+inline FV load_lanes(const float* p) { return FV(_mm512_loadu_ps(p)); }
+#else
+inline FV load_lanes(const float* p) { return FV(_mm256_loadu_ps(p)); }
+#endif
+
+// A table value in every lane: one broadcast (splat adds +0.0f, which the compiler must
+// keep for -0.0; no sign of zero matters to the axis-plane test).
+#if PB_SIMD_LANES == 16
+inline FV bcast(const float& x) { return FV(_mm512_set1_ps(x)); }
+#else
+inline FV bcast(const float& x) { return FV(_mm256_set1_ps(x)); }
+#endif
+
+// The axis-plane test's per-ray data (tiny_scene.h AxisGroup; docs/notes/cpu-log.md gives
+// the argument). Per axis c: 1 / D_c; the edge margin's factors (m = G a_c + b_c, G =
+// |X - R|_inf in the plane); whether a lane may use the test for a plane of normal axis c
+// (`ok`: its origin and D_c in the ranges the argument needs, M <= the scene's
+// axis_m_ok); D_c == 0 (Embree's den is 0: it rejects every such triangle).
+struct AxisRays {
+  FV inv_d[3], ma[3], mb[3];
+  IV ok[3], d_zero[3];
+  FV tn_front, tn_behind, tf_before, tf_beyond;  // tnear and tfar, widened by Embree's and our t error
+};
+
+inline IV in_range(FV a, float lo, float hi) { return (a >= lo) & (a <= hi); }
+
+inline void axis_rays(const TinyScene& s, const FV* oc, const FV* dc, FV omax, FV tnear, FV tfar, AxisRays& a) {
+  IV base = omax <= s.axis_o_ok;  // M <= |o|_inf + pmax <= axis_m_ok
+  for (int c = 0; c < 3; ++c) base &= (oc[c] == 0.0f) | in_range(abs(oc[c]), 0x1p-20f, 0x1p20f);
+  for (int c = 0; c < 3; ++c) {
+    a.inv_d[c] = 1.0f / dc[c];
+    a.ok[c] = base & in_range(abs(dc[c]), 0x1p-20f, 0x1p20f);
+    a.d_zero[c] = base & (dc[c] == 0.0f);
+  }
+  // |Embree's t - our t| <= 11 u |t| (the entry); the bands are 2^-18 (5.8x that).
+  a.tn_front = tnear * (1.0f + 0x1p-18f);
+  a.tn_behind = tnear * (1.0f - 0x1p-18f);
+  a.tf_before = tfar * (1.0f - 0x1p-18f);
+  a.tf_beyond = tfar * (1.0f + 0x1p-18f);
+}
+// The edge margins' factors, computed where a first edge test is needed (shadow rays
+// seldom need one).
+inline void axis_margins(const TinyScene& s, FV m_bound, FV d1, AxisRays& a) {
+  // Embree's error against exact arithmetic (vertex rounding and its formula), plus its
+  // tolerance and our error, in units of our edge functions: u K (6 M G + 17 E G + 32 E M
+  // + 22 E^2), K = |D|_1 / |D_c|, u = 2^-24 (the entry's derivation); times 3.
+  const float E = s.axis_e;
+  const FV a_c = 0x1p-24f * madd(18.0f, m_bound, splat(51.0f * E));
+  const FV b_c = (0x1p-24f * E) * madd(96.0f, m_bound, splat(66.0f * E));
+  for (int c = 0; c < 3; ++c) {
+    const FV K = d1 * abs(a.inv_d[c]);
+    a.ma[c] = K * a_c;
+    a.mb[c] = K * b_c;
+  }
+}
+
+// The closest-hit bookkeeping of one candidate (a triangle, or a group's two halves at
+// one t): `proven` a hit at t (Embree's t within err), `doubt` neither proven nor
+// irrelevant (at t - err where `known`, else anywhere from 0).
 template <bool AnyHit>
-inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in) {
-  FV c[6], tfar;
-  for (int j = 0; j < 6; ++j) std::memcpy(&c[j], rays[j], sizeof(FV));
-  std::memcpy(&tfar, tfar_in, sizeof tfar);
-  const V3 o{c[0], c[1], c[2]}, d{c[3], c[4], c[5]};
-  const FV oc[3] = {o.x, o.y, o.z};
-  FV m_bound = splat(0.0f);
-  for (int j = 0; j < 3; ++j) m_bound = vmax(m_bound, vmax(abs(s.hi[j] - oc[j]), abs(oc[j] - s.lo[j])));
-  m_bound = m_bound * (1.0f + 0x1p-20f);  // the rounding of vertex - origin
-  const FV d1 = abs(d.x) + abs(d.y) + abs(d.z);
+inline void tiny_update(TinyResult& r, IV proven, IV doubt, FV t, FV err, IV known, UV id) {
+  if constexpr (AnyHit) {
+    r.best = select(proven, t, r.best);
+    r.other_lo = select(doubt, splat(0.0f), r.other_lo);
+    return;
+  }
+  const FV doubt_lo = select(known, t - err, splat(0.0f));
+  const IV nearer = proven & (t < r.best);
+  r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best - r.best_err, t - err)), r.other_lo);
+  r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
+  r.best = select(nearer, t, r.best);
+  r.best_err = select(nearer, err, r.best_err);
+  r.id = nearer ? id : r.id;
+}
+
+// The general triangles (tiny_scene.h `general`): Embree's robust Pluecker test operation
+// for operation, with margins (the header comment above).
+template <bool AnyHit>
+inline void general_test(const TinyScene& s, V3 o, V3 d, FV tfar, FV m_bound, FV d1, FV omax, FV dmx, FV tnear,
+                         TinyResult& r) {
   const FV m_scale = 0x1p-16f * m_bound * d1;  // times this triangle's E
   const FV inf = splat(__builtin_inff());
   const FV tfar_lo = tfar * (1.0f - 0x1p-20f), tfar_hi = tfar * (1.0f + 0x1p-20f);
   const FV tfar_finite = select(tfar < splat(__builtin_inff()), tfar, splat(0.0f));
-  // Embree's tnear for these rays (embree_rays.h: ray_t_min, watertight.h), in the same
-  // float operations, and its rounding band as tfar's.
-  const FV omax = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)), dmx = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
-  const FV tnear = select(dmx > 0.0f, 0x1p-21f * omax * (1.0f / dmx), splat(0.0f));
   const FV tnear_lo = tnear * (1.0f - 0x1p-20f), tnear_hi = tnear * (1.0f + 0x1p-20f);
-  TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
   // The plane cull's scale (below): |o|_inf + t_end |d|_inf + the scene's largest
   // coordinate bounds |x| on the segment and |vertex - x|. Shadow rays: t_end = tfar
   // (inf: never culled). Closest hits: once every lane has a proven hit, t_end = its far
   // end, best + err: a triangle the segment misses is farther than the hit in Embree's
   // arithmetic too, and clear of its interval.
-  const FV dmax = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
-  const FV cull_base = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)) + s.pmax;
+  const FV dmax = dmx;
+  const FV cull_base = omax + s.pmax;
   const FV shadow_scale = madd_v(tfar, dmax, cull_base);
-  for (const TinyScene::Triangle& tr : s.triangles) {
+  for (const uint32_t row : s.general) {
+    const TinyScene::Triangle& tr = s.triangles[row];
     if constexpr (AnyHit) {
       // Skipped where every lane is away or blocked already.
       if (lane_mask(~plane_away(tr, o, d, tfar, shadow_scale) & (r.best == inf)) == 0) continue;
@@ -168,25 +233,101 @@ inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const 
     }
     const IV proven = ed.inside_any & ~z.grazing & z.front & z.before;
     const IV doubt = ~proven & ~ed.outside & ~z.away;
-    const FV abs_den = z.abs_den, Ts = z.Ts, band = z.band;
-    const IV front = z.front, grazing = z.grazing;
-    const FV rcp = 1.0f / abs_den;
-    const FV t = Ts * rcp, err = (band + abs(t) * z.den_band) * rcp + 0x1p-20f * abs(t);
+    const FV rcp = 1.0f / z.abs_den;
+    const FV t = z.Ts * rcp;
+    const FV err = (z.band + abs(t) * z.den_band) * rcp + 0x1p-20f * abs(t);
+    tiny_update<AnyHit>(r, proven, doubt, t, err, z.front & ~z.grazing, UV{} + tr.triangle);
     if constexpr (AnyHit) {
-      r.best = select(proven, t, r.best);
-      r.other_lo = select(doubt, splat(0.0f), r.other_lo);
-      if (lane_mask(r.best == inf) == 0) break;  // every ray blocked: doubts no longer matter
-      continue;
+      if (lane_mask(r.best == inf) == 0) return;  // every ray blocked: doubts no longer matter
     }
-    // A doubt's distance counts only where it is known (in front, not grazing); else 0.
-    const FV doubt_lo = select(front & ~grazing, t - err, splat(0.0f));
-    const IV nearer = proven & (t < r.best);
-    r.other_lo = select(proven, vmin(r.other_lo, select(nearer, r.best - r.best_err, t - err)), r.other_lo);
-    r.other_lo = select(doubt, vmin(r.other_lo, doubt_lo), r.other_lo);
-    r.best = select(nearer, t, r.best);
-    r.best_err = select(nearer, err, r.best_err);
-    r.id = nearer ? UV{} + tr.triangle : r.id;
   }
+}
+
+// Every triangle of `s` against the rays; `AnyHit` (occlusion): only whether a proven
+// hit exists, and stop once every lane has one.
+template <bool AnyHit>
+inline TinyResult tiny_test(const TinyScene& s, const float* const* rays, const float* tfar_in) {
+  FV c[6], tfar;
+  for (int j = 0; j < 6; ++j) c[j] = load_lanes(rays[j]);
+  tfar = load_lanes(tfar_in);
+  const V3 o{c[0], c[1], c[2]}, d{c[3], c[4], c[5]};
+  const FV oc[3] = {o.x, o.y, o.z}, dc[3] = {d.x, d.y, d.z};
+  // M: a bound on |vertex - origin| (every component, every vertex), with its rounding;
+  // only where the margins need it.
+  auto m_bound_of = [&] {
+    FV m = splat(0.0f);
+    for (int j = 0; j < 3; ++j) m = vmax(m, vmax(abs(s.hi[j] - oc[j]), abs(oc[j] - s.lo[j])));
+    return m * (1.0f + 0x1p-20f);
+  };
+  const FV d1 = abs(d.x) + abs(d.y) + abs(d.z);
+  const FV inf = splat(__builtin_inff());
+  // Embree's tnear for these rays (embree_rays.h: ray_t_min, watertight.h), in the same
+  // float operations.
+  const FV omax = vmax(vmax(abs(o.x), abs(o.y)), abs(o.z)), dmx = vmax(vmax(abs(d.x), abs(d.y)), abs(d.z));
+  const FV tnear = select(dmx > 0.0f, 0x1p-21f * omax * (1.0f / dmx), splat(0.0f));
+  TinyResult r{inf, splat(0.0f), inf, UV{} + RTC_INVALID_GEOMETRY_ID};
+  if (!s.groups.empty()) {
+    AxisRays a;
+    axis_rays(s, oc, dc, omax, tnear, tfar, a);
+    bool margins = false;
+    for (const TinyScene::AxisGroup& g : s.groups) {
+      const int k = g.k;
+      const FV t = (bcast(g.P) - oc[k]) * a.inv_d[k];  // P - o_k: Embree's own first operation
+      const IV ok = a.ok[k];
+      const IV front = t > a.tn_front, before = t < a.tf_before;
+      IV away = a.d_zero[k] | (ok & ((t < a.tn_behind) | (t > a.tf_beyond)));
+      IV done;
+      if constexpr (AnyHit) {
+        done = away | (r.best < inf);  // blocked lanes need no answer
+      } else {
+        // Beyond the lane's proven hit and its interval: it can neither win nor make the
+        // lane unsure (as the plane cull below).
+        away |= ok & (t * (1.0f - 0x1p-18f) > r.best + r.best_err);
+        done = away;
+      }
+      if (lane_mask(~done) == 0) continue;
+      if (!margins) {
+        axis_margins(s, m_bound_of(), d1, a);
+        margins = true;
+      }
+      const int i = g.i, j = g.j;
+      const FV yi = madd_v(t, dc[i], oc[i] - bcast(g.Ri)), yj = madd_v(t, dc[j], oc[j] - bcast(g.Rj));
+      const FV m = madd_v(vmax(abs(yi), abs(yj)), a.ma[k], a.mb[k]);
+      const IV hit_ok = ok & front & before & ~away;
+      // Triangle h of the group: proven hit, or away (rejected by Embree or beyond).
+      auto half = [&](int h, IV& proven, IV& away_h) {
+        const float(*e)[3] = g.e[h];
+        const FV f0 = madd_v(bcast(e[0][0]), yi, madd_v(bcast(e[0][1]), yj, bcast(e[0][2])));
+        const FV f1 = madd_v(bcast(e[1][0]), yi, madd_v(bcast(e[1][1]), yj, bcast(e[1][2])));
+        const FV f2 = madd_v(bcast(e[2][0]), yi, madd_v(bcast(e[2][1]), yj, bcast(e[2][2])));
+        const FV lo = vmin(vmin(f0, f1), f2), hi = vmax(vmax(f0, f1), f2);
+        proven = hit_ok & (lo > m);
+        away_h = away | (ok & (lo < -m) & (hi > m));
+      };
+      IV p0, a0;
+      half(0, p0, a0);
+      const FV err = abs(t) * 0x1p-19f;  // 2.9x the bound
+      const IV known = ok & front;
+      if (g.count == 1) {
+        tiny_update<AnyHit>(r, p0, ~p0 & ~a0, t, err, known, UV{} + g.id[0]);
+      } else {
+        IV p1, a1;
+        half(1, p1, a1);
+        if constexpr (AnyHit) {
+          tiny_update<AnyHit>(r, p0 | p1, (~p0 & ~a0) | (~p1 & ~a1), t, err, known, UV{});
+        } else {
+          // One candidate at t: a proven hit where one half is and the other is away; a
+          // doubt where neither is away and not exactly one proven.
+          const IV proven = (p0 & a1) | (p1 & a0);
+          tiny_update<AnyHit>(r, proven, ~proven & ~(a0 & a1), t, err, known, p0 ? UV{} + g.id[0] : UV{} + g.id[1]);
+        }
+      }
+      if constexpr (AnyHit) {
+        if (lane_mask(r.best == inf) == 0) return r;  // every ray blocked: doubts no longer matter
+      }
+    }
+  }
+  if (!s.general.empty()) general_test<AnyHit>(s, o, d, tfar, m_bound_of(), d1, omax, dmx, tnear, r);
   return r;
 }
 
@@ -201,7 +342,8 @@ inline uint32_t tiny_occluded(const TinyScene& s, const float* const* rays, cons
   const TinyResult r = tiny_test<true>(s, rays, tfar);
   const FV inf = splat(__builtin_inff());
   const IV hit = r.best < inf;
-  for (int i = 0; i < kLanes; ++i) blocked[i] = hit[i] != 0;
+  const uint32_t m = lane_mask(hit);
+  for (int i = 0; i < kLanes; ++i) blocked[i] = (m >> i) & 1;
   return lane_mask(~hit & (r.other_lo < inf));
 }
 
