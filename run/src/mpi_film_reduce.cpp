@@ -2,6 +2,7 @@
 // rank's 64-bit integer sums and counts into rank 0's film, overflow checked.
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -128,6 +129,80 @@ void World::reduce_film_rows(Film& film, const std::vector<RowRange>& mine) {
       if (film.has_variance()) receive_add(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE, from, sq, ok);
     }
   if (!inside) throw std::invalid_argument("reduce_film_rows: rows outside the film");
+  if (!ok) throw std::overflow_error("reduce_film: a pixel sum or sample count overflows");
+}
+
+// A sender's header (send_film_rows): its film's width, height, scale (bits), variance, then
+// its row ranges as (first, count) pairs.
+constexpr int kRowsHeaderTag = 7302;
+std::vector<uint64_t> rows_header(const Film& film, const std::vector<RowRange>& mine) {
+  uint64_t scale_bits;
+  const double scale = film.scale();
+  std::memcpy(&scale_bits, &scale, sizeof scale_bits);
+  std::vector<uint64_t> h{film.width(), film.height(), scale_bits, film.has_variance() ? 1u : 0u};
+  for (const RowRange& r : mine) h.push_back(r.first), h.push_back(r.count);
+  return h;
+}
+
+void World::send_film_rows(Film& film, const std::vector<RowRange>& mine, const std::vector<int>& senders) {
+  if (!mpi_ || size_ == 1) return;
+  const size_t w = film.width();
+  if (!root()) {
+    if (mine.empty()) return;  // rank 0 expects nothing of a rank that traced nothing
+    const std::vector<uint64_t> h = rows_header(film, mine);
+    MPI_Send(h.data(), int(h.size()), MPI_UINT64_T, 0, kRowsHeaderTag, MPI_COMM_WORLD);
+    for (const RowRange& r : mine) {
+      if (uint64_t(r.first) + r.count > film.height()) continue;  // rank 0 refuses them (the header says so)
+      const size_t px0 = size_t(r.first) * w, px = size_t(r.count) * w;
+      send_piece(film.raw_sums().data() + px0 * 3, px * 3, MPI_INT64_T);
+      send_piece(film.counts().data() + px0, px, MPI_UINT32_T);
+      if (film.has_variance()) send_piece(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE);
+    }
+    return;
+  }
+  // Rank 0: every sender's header, then its rows (into scratch where they cannot be added:
+  // every message is received before anything is refused, so that no sender is left blocked).
+  const std::vector<uint64_t> own = rows_header(film, {});
+  bool ok = true;
+  std::string refused;
+  std::vector<int64_t> sums;
+  std::vector<uint32_t> cnt;
+  std::vector<double> sq;
+  for (int from : senders) {
+    MPI_Status st;
+    MPI_Probe(from, kRowsHeaderTag, MPI_COMM_WORLD, &st);
+    int n = 0;
+    MPI_Get_count(&st, MPI_UINT64_T, &n);
+    std::vector<uint64_t> h(size_t(std::max(n, 0)));
+    MPI_Recv(h.data(), n, MPI_UINT64_T, from, kRowsHeaderTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    const bool same = h.size() >= own.size() && std::equal(own.begin(), own.end(), h.begin()) && h.size() % 2 == 0;
+    if (!same && refused.empty())
+      refused = fmt::format("send_film_rows: rank {}'s film differs from rank 0's (size, scale or variance)", from);
+    for (size_t i = own.size(); i + 1 < h.size(); i += 2) {
+      const uint64_t first = h[i], count = h[i + 1];
+      if (same && first + count <= film.height()) {
+        const size_t px0 = size_t(first) * w, px = size_t(count) * w;
+        receive_add(film.raw_sums().data() + px0 * 3, px * 3, MPI_INT64_T, from, sums, ok);
+        receive_add(film.counts().data() + px0, px, MPI_UINT32_T, from, cnt, ok);
+        if (film.has_variance()) receive_add(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE, from, sq, ok);
+        continue;
+      }
+      if (refused.empty()) refused = fmt::format("send_film_rows: rank {} sent rows outside the film", from);
+      if (first + count > h[1]) continue;  // outside its own film too: it sent nothing for them
+      // Not added: its messages are drained (as many as it sent: send_piece's pieces).
+      const uint64_t px = count * h[0];
+      for (uint64_t values : {px * 3, px, h[3] ? px * 3 : 0})
+        for (uint64_t at = 0; at < values; at += kRowPiece) {
+          MPI_Status ps;
+          MPI_Probe(from, kRowsTag, MPI_COMM_WORLD, &ps);
+          int bytes = 0;
+          MPI_Get_count(&ps, MPI_BYTE, &bytes);
+          std::vector<uint8_t> sink(size_t(std::max(bytes, 0)));
+          MPI_Recv(sink.data(), bytes, MPI_BYTE, from, kRowsTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        }
+    }
+  }
+  if (!refused.empty()) throw std::invalid_argument(refused);
   if (!ok) throw std::overflow_error("reduce_film: a pixel sum or sample count overflows");
 }
 
