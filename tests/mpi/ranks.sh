@@ -38,7 +38,9 @@ mkdir -p "$dir"
 cd "$dir" || exit 1
 # CI runs as root on 2 cores.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-mpi="$mpiexec --oversubscribe --bind-to none"
+# PB_MPI_ARGS: more mpirun options (two_nodes.sh: the hostfile and launch agent of its
+# namespaces); PB_TCP_ARGS: the TCP-only options in place of the loopback's.
+mpi="$mpiexec --oversubscribe --bind-to none ${PB_MPI_ARGS:-}"
 base="render --quiet --width 64 --height 64 --bounces 2"
 frame="$base --spp 24"
 fail() { echo "ranks.sh $case_name: $*" >&2; exit 1; }
@@ -72,7 +74,7 @@ killed() {
   refused "$status" "." x.pfm
 }
 # Between nodes there is no shared memory: TCP alone, on the loopback interface here.
-tcp="--mca btl self,tcp --mca btl_tcp_if_include lo --mca pml ob1 --mca osc ^sm,rdma"
+tcp=${PB_TCP_ARGS:-"--mca btl self,tcp --mca btl_tcp_if_include lo --mca pml ob1 --mca osc ^sm,rdma"}
 
 case $case_name in
   tcp)

@@ -5,9 +5,10 @@
 # launch agent that enters that namespace (--mca plm_rsh_agent, in place of ssh), as it
 # would start it on another host.
 #   sh two_nodes.sh CASE PATHBENCH MPIEXEC DIR
-# veth              static and dynamic balance: the one-process image byte for byte
-# veth_killed_rank  the rank on the second node SIGKILLed: the run ends within 30 s, non-zero,
-#                   with a message naming the lost process, no image
+# veth              ranks.sh tcp over the two nodes: static and dynamic balance give the
+#                   one-process image byte for byte; the reports name both nodes
+# veth_killed_rank  ranks.sh tcp_killed_rank: the rank on node B SIGKILLed: the run ends within 30 s,
+#                   non-zero, with a message naming the lost process, no image
 # Skipped (status 77, with the reason) where user and network namespaces or veth links
 # cannot be made (unshare -rnu, ip link add ... type veth): e.g. a container without them.
 set -u
@@ -58,39 +59,19 @@ EOF
 chmod +x agent.sh
 printf '10.77.0.1 slots=1\n10.77.0.2 slots=1\n' > hosts
 net=10.77.0.0/24
-mpi="$mpiexec --hostfile hosts --map-by node --bind-to none --mca plm_rsh_agent $PWD/agent.sh
-     --mca btl self,tcp --mca btl_tcp_if_include $net --mca oob_tcp_if_include $net --mca pml ob1 --mca osc ^sm,rdma"
-base="render --quiet --width 64 --height 64 --bounces 2"
-frame="$base --spp 24"
-film_hash() { grep -o '"film_hash": "[^"]*"' "$1"; }
-run() {
-  timeout 60 $mpi "$@" >out.txt 2>err.txt
-  status=$?
-}
-
+# ranks.sh's TCP cases, run from node A over both nodes (one rank a node).
+export PB_MPI_ARGS="--hostfile $PWD/hosts --map-by node --mca plm_rsh_agent $PWD/agent.sh"
+export PB_TCP_ARGS="--mca btl self,tcp --mca btl_tcp_if_include $net --mca oob_tcp_if_include $net --mca pml ob1 --mca osc ^sm,rdma"
 case $case_name in
   veth)
-    "$pb" $frame --threads 1 --out one.pfm --report one.json || fail "one-process render failed"
+    sh "$here/ranks.sh" tcp "$pb" "$mpiexec" "$PWD/tcp" || fail "ranks.sh tcp over the two nodes failed"
+    # Each rank on its own node: the reports name both hosts.
     for balance in static dynamic; do
-      run -np 2 "$pb" $frame --balance $balance --out $balance.pfm --report $balance.json
-      [ "$status" = 0 ] || { cat err.txt >&2; fail "2 nodes, --balance $balance: status $status"; }
-      cmp -s one.pfm $balance.pfm || fail "2 nodes, --balance $balance: the image differs from one process's"
-      [ "$(film_hash one.json)" = "$(film_hash $balance.json)" ] || fail "2 nodes, --balance $balance: film_hash differs"
-      # Each rank on its own node: the report names both hosts.
-      grep -q '"pb-node-a"' $balance.json && grep -q '"pb-node-b"' $balance.json ||
+      grep -q '"pb-node-a"' tcp/$balance.json && grep -q '"pb-node-b"' tcp/$balance.json ||
         fail "2 nodes, --balance $balance: the report does not name both nodes"
     done ;;
   veth_killed_rank)
-    start=$(date +%s)
-    run -np 1 "$pb" $base --spp 100000 --out x.pfm : \
-        -np 1 sh -c "\"$pb\" $base --spp 100000 --out x.pfm & p=\$!; sleep 2; kill -9 \$p; wait \$p"
-    elapsed=$(( $(date +%s) - start ))
-    [ "$status" != 0 ] || fail "the run succeeded"
-    [ "$status" != 124 ] || fail "the run hung (killed by timeout after 60 s)"
-    [ "$elapsed" -le 30 ] || fail "the run took $elapsed s to end"
-    grep -q "exited on signal 9\|Exit code: *137\|signal 9" err.txt || { cat err.txt >&2; fail "no word of the killed rank"; }
-    [ ! -e x.pfm ] || fail "x.pfm was written"
-    ls | grep -q '\.tmp' && fail "a temporary file was left: $(ls)" ;;
+    sh "$here/ranks.sh" tcp_killed_rank "$pb" "$mpiexec" "$PWD/killed" || fail "ranks.sh tcp_killed_rank over the two nodes failed" ;;
   *) fail "unknown case" ;;
 esac
 echo "two_nodes.sh $case_name: ok"
