@@ -245,6 +245,12 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     throw_agreed(w, w.agree(failed));
     if (dispenser && w.root()) granted = dispenser->chunks_granted(), senders = dispenser->ranks_granted();
   }
+  // PATHBENCH_RANK_FILM_HASH=1 (diagnostics, issue 30): each CPU rank's own film before the
+  // reduction, hashed into its report entry, so that runs that differ say whether a rank's
+  // samples or the reduction did. Costs rank 0 a pass over its film inside the frame.
+  const char* hash_env = std::getenv("PATHBENCH_RANK_FILM_HASH");
+  const std::string part_hash =
+      hash_env && std::string(hash_env) == "1" && s.device == Device::Cpu ? film_hash(film) : std::string();
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
   const double wait_seconds = std::chrono::duration<double>(r0 - t0).count() - mine.seconds;
@@ -284,6 +290,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   nlohmann::json entry = rank_entry(w.rank(), w.host(), s, mine, gpu_index, samples, chunks, busy_wall);
   // Where this rank's frame went: tracing (its tracer calls), waiting (chunk requests, the
   // slowest rank), and the reduction (bound check, NCCL, the download, MPI).
+  if (!part_hash.empty()) entry["film_hash"] = part_hash;  // this rank's film before the reduction
   entry["trace_seconds"] = mine.seconds;
   entry["wait_seconds"] = std::max(0.0, wait_seconds);
   entry["reduce_seconds"] = reduce_seconds;
