@@ -162,6 +162,9 @@ def entry(kind: str, frame, n: int, runs: list[dict], base: list[dict] | None, t
     e = {"experiment": kind, "width": frame[0], "height": frame[1], "spp": frame[2], "ranks": n, "seconds": t,
          "seconds_all": [r["seconds"] for r in runs],
          "film_hash_all": [r["film_hash"] for r in runs],
+         # PATHBENCH_RANK_FILM_HASH=1 in the ranks' environment: each CPU rank's film before the reduction.
+         "rank_film_hashes_all": [[p.get("film_hash") for p in (r["report"].get("ranks") or {}).get("per_rank", [])]
+                                  for r in runs],
          "rays_per_second": report["rays"]["total"] / t if t > 0 else None,
          "film_hash": m["film_hash"],
          "load_balance": ranks.get("load_balance"), "parallel_efficiency": ranks.get("parallel_efficiency"),
