@@ -17,8 +17,9 @@ Experiments (GPU counts: 1, 2, 4, 8, ... up to --gpus, and --gpus itself):
                 --hybrid-rounds interleaved rounds at each frame
   strong-cpu / weak-cpu   the same over --cpu-ranks CPU ranks
 Every run's image and film hash is compared with the experiment's one-rank run (every
-repetition, not only the median), so a difference says whether the film differed (its
-film_hash) or only the file.
+repetition, not only the median; film_hash_all keeps each repetition's), so a difference says
+whether the film differed (its film_hash), only the file, or only the film (its 64-bit sums
+below the float image's resolution): each is NOT IDENTICAL.
 
 Times: a run's frame is from its start to the film on the host: N ranks' `ranks.frame_seconds`
 (common start to the film reduced on rank 0), one process's `seconds` (host clock around its
@@ -138,12 +139,17 @@ def compare(base: list[dict] | None, runs: list[dict]) -> dict:
     ref = base[0]
     same_images = all(r["image_sha256"] == ref["image_sha256"] for r in runs + base)
     same_films = all(r["film_hash"] == ref["film_hash"] for r in runs + base)
-    out = {"identical": same_images, "film_hash_identical": same_films}
-    if not same_images:
-        out["difference"] = ("the film differs (film_hash)" if not same_films
+    # Identical: the image bytes and the film (its 64-bit sums: a difference below a float's
+    # resolution of the mean leaves the image's bytes as they were).
+    out = {"identical": same_images and same_films, "image_identical": same_images,
+           "film_hash_identical": same_films}
+    if not (same_images and same_films):
+        out["difference"] = ("the film differs (film_hash)" if same_images is same_films
+                             else "the film differs while the image file is the same" if same_images
                              else "the image file differs while the film is the same")
         out["image_sha256"] = sorted({r["image_sha256"] for r in runs + base})
         out["film_hashes"] = sorted({str(r["film_hash"]) for r in runs + base})
+        out["base_film_hash"] = ref["film_hash"]
     return out
 
 
@@ -155,6 +161,10 @@ def entry(kind: str, frame, n: int, runs: list[dict], base: list[dict] | None, t
     t = m["seconds"]
     e = {"experiment": kind, "width": frame[0], "height": frame[1], "spp": frame[2], "ranks": n, "seconds": t,
          "seconds_all": [r["seconds"] for r in runs],
+         "film_hash_all": [r["film_hash"] for r in runs],
+         # PATHBENCH_RANK_FILM_HASH=1 in the ranks' environment: each CPU rank's film before the reduction.
+         "rank_film_hashes_all": [[p.get("film_hash") for p in (r["report"].get("ranks") or {}).get("per_rank", [])]
+                                  for r in runs],
          "rays_per_second": report["rays"]["total"] / t if t > 0 else None,
          "film_hash": m["film_hash"],
          "load_balance": ranks.get("load_balance"), "parallel_efficiency": ranks.get("parallel_efficiency"),

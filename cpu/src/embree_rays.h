@@ -97,9 +97,13 @@ inline void occluded_packet(int n, RTCScene s, RTCIntersectContext* c, RTCRayNt<
   rtcOccluded16(LaneMask<16>(n).valid, s, c, reinterpret_cast<RTCRay16*>(&p));
 }
 
-// Packet fields that stay as set: everything but the ray, tfar and the hit.
+// Packet fields that stay as set: everything but the ray, tfar and the hit. The rays start
+// at zero: the tiny test (tiny_x8.h) reads every lane, the inactive ones too (their rays
+// from earlier calls, or these zeros), never uninitialised memory (valgrind: its skips
+// branched on it; the answers of the active lanes do not depend on the others').
 template <int W> void init_packet_constants(RTCRayNt<W>& r) {
   for (int i = 0; i < W; ++i) {
+    r.org_x[i] = r.org_y[i] = r.org_z[i] = r.dir_x[i] = r.dir_y[i] = r.dir_z[i] = 0.0f;
     r.tnear[i] = 0.0f;  // set per call from the rays (set_tnear)
     r.time[i] = 0.0f;
     r.mask[i] = 0xFFFFFFFFu;

@@ -237,39 +237,42 @@ inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const Sce
 }
 
 // The closest hits of the rays `rays` (six arrays of W: org x, y, z, dir x, y, z; lanes
-// [0, n) valid; W = k.lanes) with packet `p`'s tfar: the tiny test, and where it leaves
-// any lane unsure, Embree for the whole packet (the rays copied into `p` unless they are
-// its own arrays), as the tracer asked before: Embree's own answer for a ray exactly at
-// an edge or at tfar depends on which other lanes are active (packet or single-ray
-// traversal, whose formulas round differently), so only the same call gives the same
-// answer. prim[i]: the scene triangle, or RTC_INVALID_GEOMETRY_ID. Returns the number of
-// unsure lanes (after which the caller resets `p`).
+// [0, n) valid; W = k.lanes) with packet `p`'s tfar: the tiny test, and for each lane it
+// leaves unsure, Embree for that ray alone (rtcIntersect1, trace_path's query). Not Embree's
+// packet: its answer for a ray exactly at an edge or at tfar depends on the packet's other
+// active lanes (how many there are: the packet and the single-ray traversals round
+// differently; TinyIsa.AnswersDoNotDependOnPacketMates found rays blocked in a packet of 16
+// and clear alone), and which rays share a packet depends on the rank's share of the samples
+// (issue 30). A ray's answer is then its own whatever its packet: the test's proven answer,
+// or Embree's single-ray one. prim[i]: the scene triangle, or RTC_INVALID_GEOMETRY_ID.
+// Returns the number of unsure lanes; `p` is not changed.
 template <int W>
 int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e, RTCIntersectContext& ctx,
                  const float* const* rays, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
-  uint32_t unsure = k.tiny_closest(t, rays, p.ray.tfar, prim) & uint32_t((uint64_t(1) << n) - 1);
+  const uint32_t unsure = k.tiny_closest(t, rays, p.ray.tfar, prim) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
   PB_STAGE(kClosestEmbree);
-  copy_rays<W>(rays, p.ray);
-  intersect_packet(n, e.handle(), &ctx, p);
-  for (int i = 0; i < n; ++i)
-    if ((unsure >> i) & 1) prim[i] = packet_triangle(e, p, i);
+  for (uint32_t u = unsure; u != 0; u &= u - 1) {
+    const int i = __builtin_ctz(u);
+    prim[i] = closest_triangle(e, ctx, Ray<float>{{rays[0][i], rays[1][i], rays[2][i]}, {rays[3][i], rays[4][i], rays[5][i]}});
+  }
   return __builtin_popcount(unsure);
 }
 
 // Whether each shadow ray of `rays` (as tiny_closest; tfar: packet `p`'s) is blocked:
-// the tiny test, then (as tiny_closest) Embree for the whole packet where it left a
-// lane unsure. Returns the number of unsure lanes.
+// the tiny test, then (as tiny_closest) Embree for each ray it left unsure alone
+// (rtcOccluded1 up to its tfar). Returns the number of unsure lanes; `p` is not changed.
 template <int W>
 int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e, RTCIntersectContext& ctx,
                   const float* const* rays, RTCRayNt<W>& p, int n, bool* blocked) {
-  uint32_t unsure = k.tiny_occluded(t, rays, p.tfar, blocked) & uint32_t((uint64_t(1) << n) - 1);
+  const uint32_t unsure = k.tiny_occluded(t, rays, p.tfar, blocked) & uint32_t((uint64_t(1) << n) - 1);
   if (unsure == 0) return 0;
   PB_STAGE(kShadowEmbree);
-  copy_rays<W>(rays, p);
-  occluded_packet(n, e.handle(), &ctx, p);
-  for (int i = 0; i < n; ++i)
-    if ((unsure >> i) & 1) blocked[i] = p.tfar[i] < 0.0f;
+  for (uint32_t u = unsure; u != 0; u &= u - 1) {
+    const int i = __builtin_ctz(u);
+    blocked[i] = occluded(e, ctx, Ray<float>{{rays[0][i], rays[1][i], rays[2][i]}, {rays[3][i], rays[4][i], rays[5][i]}},
+                          p.tfar[i]);
+  }
   return __builtin_popcount(unsure);
 }
 
@@ -294,7 +297,7 @@ template <int W>
 void closest_hits(const BatchKernels& k, const TinyScene* tiny, const EmbreeScene& e, RTCIntersectContext& ctx,
                   const float* const* rays, RTCRayHitNt<W>& p, int n, uint32_t* prim) {
   if (tiny) {
-    if (tiny_closest<W>(k, *tiny, e, ctx, rays, p, n, prim) > 0) reset_packet(p);
+    tiny_closest<W>(k, *tiny, e, ctx, rays, p, n, prim);
     return;
   }
   copy_rays<W>(rays, p.ray);
@@ -304,7 +307,7 @@ template <int W>
 void shadows_blocked(const BatchKernels& k, const TinyScene* tiny, const EmbreeScene& e, RTCIntersectContext& ctx,
                      const float* const* rays, RTCRayNt<W>& p, int n, bool* blocked) {
   if (tiny) {
-    if (tiny_occluded<W>(k, *tiny, e, ctx, rays, p, n, blocked) > 0) reset_packet(p);
+    tiny_occluded<W>(k, *tiny, e, ctx, rays, p, n, blocked);
     return;
   }
   copy_rays<W>(rays, p);

@@ -97,7 +97,7 @@ template <class T> struct PoolSlice {
 // Tags are pool slots, | ShadeStream::kEnds where the path is done once its ray is
 // answered. Contributions in T (a double path step adds double radiance).
 template <class T, int W> struct PendingShadows {
-  alignas(64) float ray[6][2 * W];
+  alignas(64) float ray[6][2 * W] = {};  // zero: the tiny test reads every lane of a packet (embree_rays.h)
   alignas(64) T contribution[3][2 * W];
   alignas(64) uint32_t tag[2 * W];
   uint32_t n = 0;

@@ -3,6 +3,7 @@
 // rank 0's render); rank 0 itself takes chunks under the same lock. Messages go over a
 // communicator of their own (mpi_detail::chunk_comm).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <mutex>
 #include <thread>
@@ -35,7 +36,10 @@ struct SampleDispenser::Impl {
   std::vector<bool> finished;  // ranks that have had their last grant (count 0)
   std::vector<uint64_t> pending;
   std::vector<std::chrono::steady_clock::time_point> granted_at;
+  std::vector<uint64_t> granted_units;  // per rank: units handed out (ranks_granted)
   std::thread server;
+  std::atomic<bool> go{false};  // the server may call MPI (start())
+  bool never_started = false;    // destroyed before start(): the server ends without MPI
   bool done = false;  // this rank has had its last grant (or quit)
 
   UnitRange grant(int rank, double rate, uint64_t probe) {
@@ -69,12 +73,15 @@ struct SampleDispenser::Impl {
     if (count == 0) finished[size_t(rank)] = true;
     const UnitRange s{next, count};
     next += count;
+    granted_units[size_t(rank)] += count;
     if (count) ++chunks;
     if (rates[size_t(rank)] <= 0) pending[size_t(rank)] = count, granted_at[size_t(rank)] = now;
     return s;
   }
 
   void serve() {
+    go.wait(false);  // start(): the thread was made before the frame, MPI is called from here on
+    if (never_started) return;
     int finished = 0;  // ranks that have had their last grant or quit
     while (finished < world.size() - 1) {
       int flag = 0;
@@ -108,15 +115,26 @@ SampleDispenser::SampleDispenser(World& world, uint64_t units, const std::vector
   impl_->pending.assign(size_t(world.size()), 0);
   impl_->finished.assign(size_t(world.size()), false);
   impl_->granted_at.resize(size_t(world.size()));
+  impl_->granted_units.assign(size_t(world.size()), 0);
   if (world.root() && world.size() > 1) impl_->server = std::thread([this] { impl_->serve(); });
 }
 
 SampleDispenser::~SampleDispenser() {
+  if (!impl_->go) {  // never started (the frame failed before its start): the thread ends at once
+    impl_->never_started = true;
+    start();
+  }
   if (impl_->server.joinable()) impl_->server.join();
+}
+
+void SampleDispenser::start() {
+  if (impl_->go.exchange(true)) return;
+  impl_->go.notify_all();
 }
 
 UnitRange SampleDispenser::next(double rate, uint64_t probe) {
   Impl& d = *impl_;
+  start();
   if (d.done) return {0, 0};
   UnitRange s;
   if (d.world.root()) {
@@ -145,7 +163,16 @@ void SampleDispenser::abort() {
 }
 
 void SampleDispenser::finish() {
+  start();
   if (impl_->server.joinable()) impl_->server.join();
+}
+
+std::vector<int> SampleDispenser::ranks_granted() const {
+  std::lock_guard<std::mutex> lock(impl_->m);
+  std::vector<int> out;
+  for (size_t r = 1; r < impl_->granted_units.size(); ++r)
+    if (impl_->granted_units[r] > 0) out.push_back(int(r));
+  return out;
 }
 
 uint64_t SampleDispenser::chunks_granted() const {

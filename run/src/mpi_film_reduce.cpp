@@ -2,6 +2,7 @@
 // rank's 64-bit integer sums and counts into rank 0's film, overflow checked.
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -59,6 +60,26 @@ template <class T> void receive_add(T* into, size_t n, MPI_Datatype type, int fr
     ok &= add_values(into + at, buf.data(), m);
   }
 }
+// Rows [first, first + count) of the film's arrays (sums, counts, variance sums): sent to
+// rank 0, or received there from `from` and added (`in` keeps the scratch and `ok`).
+void send_rows(const Film& film, size_t first, size_t count) {
+  const size_t px0 = first * film.width(), px = count * film.width();
+  send_piece(film.raw_sums().data() + px0 * 3, px * 3, MPI_INT64_T);
+  send_piece(film.counts().data() + px0, px, MPI_UINT32_T);
+  if (film.has_variance()) send_piece(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE);
+}
+struct Inbox {
+  std::vector<int64_t> sums;
+  std::vector<uint32_t> counts;
+  std::vector<double> sq;
+  bool ok = true;
+};
+void receive_rows(Film& film, size_t first, size_t count, int from, Inbox& in) {
+  const size_t px0 = first * film.width(), px = count * film.width();
+  receive_add(film.raw_sums().data() + px0 * 3, px * 3, MPI_INT64_T, from, in.sums, in.ok);
+  receive_add(film.counts().data() + px0, px, MPI_UINT32_T, from, in.counts, in.ok);
+  if (film.has_variance()) receive_add(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE, from, in.sq, in.ok);
+}
 }  // namespace
 
 void World::reduce_film(Film& film) {
@@ -105,30 +126,77 @@ void World::reduce_film_rows(Film& film, const std::vector<RowRange>& mine) {
               MPI_COMM_WORLD);
   // Then each rank's rows, in rank order: rank 0 receives them all before it judges an
   // overflow, so that no sender is left blocked in MPI_Send.
-  const size_t w = film.width();
   if (!root()) {
     if (!inside) throw std::invalid_argument("reduce_film_rows: rows outside the film");
-    for (const RowRange& r : mine) {
-      const size_t px0 = size_t(r.first) * w, px = size_t(r.count) * w;
-      send_piece(film.raw_sums().data() + px0 * 3, px * 3, MPI_INT64_T);
-      send_piece(film.counts().data() + px0, px, MPI_UINT32_T);
-      if (film.has_variance()) send_piece(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE);
-    }
+    for (const RowRange& r : mine) send_rows(film, r.first, r.count);
     return;
   }
-  bool ok = true;
-  std::vector<int64_t> sums;
-  std::vector<uint32_t> cnt;
-  std::vector<double> sq;
+  Inbox in;
   for (int from = 1; from < size_; ++from)
-    for (int i = displs[size_t(from)]; i < displs[size_t(from)] + counts[size_t(from)]; i += 2) {
-      const size_t px0 = size_t(all_rows[size_t(i)]) * w, px = size_t(all_rows[size_t(i) + 1]) * w;
-      receive_add(film.raw_sums().data() + px0 * 3, px * 3, MPI_INT64_T, from, sums, ok);
-      receive_add(film.counts().data() + px0, px, MPI_UINT32_T, from, cnt, ok);
-      if (film.has_variance()) receive_add(film.raw_sum_sq().data() + px0 * 3, px * 3, MPI_DOUBLE, from, sq, ok);
-    }
+    for (int i = displs[size_t(from)]; i < displs[size_t(from)] + counts[size_t(from)]; i += 2)
+      receive_rows(film, all_rows[size_t(i)], all_rows[size_t(i) + 1], from, in);
   if (!inside) throw std::invalid_argument("reduce_film_rows: rows outside the film");
-  if (!ok) throw std::overflow_error("reduce_film: a pixel sum or sample count overflows");
+  if (!in.ok) throw std::overflow_error("reduce_film: a pixel sum or sample count overflows");
+}
+
+// A sender's header (send_film_rows): its film's width, height, scale (bits), variance, then
+// its row ranges as (first, count) pairs.
+constexpr int kRowsHeaderTag = 7302;
+// The next message from `from` with `tag`, whatever its length, as values of `type` (T's).
+template <class T> std::vector<T> receive_message(int from, int tag, MPI_Datatype type) {
+  MPI_Status st;
+  MPI_Probe(from, tag, MPI_COMM_WORLD, &st);
+  int n = 0;
+  MPI_Get_count(&st, type, &n);
+  std::vector<T> v(size_t(std::max(n, 0)));
+  MPI_Recv(v.data(), n, type, from, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  return v;
+}
+std::vector<uint64_t> rows_header(const Film& film, const std::vector<RowRange>& mine) {
+  uint64_t scale_bits;
+  const double scale = film.scale();
+  std::memcpy(&scale_bits, &scale, sizeof scale_bits);
+  std::vector<uint64_t> h{film.width(), film.height(), scale_bits, film.has_variance() ? 1u : 0u};
+  for (const RowRange& r : mine) h.push_back(r.first), h.push_back(r.count);
+  return h;
+}
+
+void World::send_film_rows(Film& film, const std::vector<RowRange>& mine, const std::vector<int>& senders) {
+  if (!mpi_ || size_ == 1) return;
+  if (!root()) {
+    if (mine.empty()) return;  // rank 0 expects nothing of a rank that traced nothing
+    const std::vector<uint64_t> h = rows_header(film, mine);
+    MPI_Send(h.data(), int(h.size()), MPI_UINT64_T, 0, kRowsHeaderTag, MPI_COMM_WORLD);
+    for (const RowRange& r : mine)
+      if (uint64_t(r.first) + r.count <= film.height()) send_rows(film, r.first, r.count);  // else refused (the header says)
+    return;
+  }
+  // Rank 0: every sender's header, then its rows (into scratch where they cannot be added:
+  // every message is received before anything is refused, so that no sender is left blocked).
+  const std::vector<uint64_t> own = rows_header(film, {});
+  Inbox in;
+  std::string refused;
+  for (int from : senders) {
+    const std::vector<uint64_t> h = receive_message<uint64_t>(from, kRowsHeaderTag, MPI_UINT64_T);
+    const bool same = h.size() >= own.size() && std::equal(own.begin(), own.end(), h.begin()) && h.size() % 2 == 0;
+    if (!same && refused.empty())
+      refused = fmt::format("send_film_rows: rank {}'s film differs from rank 0's (size, scale or variance)", from);
+    for (size_t i = own.size(); i + 1 < h.size(); i += 2) {
+      const uint64_t first = h[i], count = h[i + 1];
+      if (same && first + count <= film.height()) {
+        receive_rows(film, first, count, from, in);
+        continue;
+      }
+      if (refused.empty()) refused = fmt::format("send_film_rows: rank {} sent rows outside the film", from);
+      if (first + count > h[1]) continue;  // outside its own film too: it sent nothing for them
+      // Not added: its messages are drained (as many as it sent: send_piece's pieces).
+      const uint64_t px = count * h[0];
+      for (uint64_t values : {px * 3, px, h[3] ? px * 3 : 0})
+        for (uint64_t at = 0; at < values; at += kRowPiece) receive_message<uint8_t>(from, kRowsTag, MPI_BYTE);
+    }
+  }
+  if (!refused.empty()) throw std::invalid_argument(refused);
+  if (!in.ok) throw std::overflow_error("reduce_film: a pixel sum or sample count overflows");
 }
 
 }  // namespace pb::run

@@ -185,10 +185,16 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     for (const std::string& r : w.all(fmt::format("{:a}", rate))) rates.push_back(std::strtod(r.c_str(), nullptr));
   }
 
+  // Dynamic balancing only: rank 0 then serves it (its units: rows x samples). Made before
+  // the frame's clock (rank 0's server thread), started after the common start.
+  std::optional<SampleDispenser> dispenser;
+  if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
+
   // 3. The frame: from a common start to the reduced film on rank 0.
   const nlohmann::json load0 = load_sample();
   w.barrier();
   const Clock::time_point t0 = Clock::now();
+  if (dispenser) dispenser->start();
   RunReport mine;
   RankFailure failed;
   uint64_t samples = 0;           // (pixel, sample) pairs this rank traced
@@ -200,10 +206,8 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     samples += uint64_t(b.rows) * s.width * b.samples;
     add_rows(rows, b);
   };
+  std::vector<int> senders;  // rank 0, dynamic: the other ranks that were granted samples
   {
-    // Dynamic balancing only: rank 0 then serves it (its units: rows x samples).
-    std::optional<SampleDispenser> dispenser;
-    if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
     try {
       if (balance == Balance::Static && bands > 1) {
         // Every GPU rank starts every band's reduction, in order: a rank with no samples, or
@@ -239,8 +243,14 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     }
     if (dispenser) dispenser->finish();
     throw_agreed(w, w.agree(failed));
-    if (dispenser && w.root()) granted = dispenser->chunks_granted();
+    if (dispenser && w.root()) granted = dispenser->chunks_granted(), senders = dispenser->ranks_granted();
   }
+  // PATHBENCH_RANK_FILM_HASH=1 (diagnostics, issue 30): each CPU rank's own film before the
+  // reduction, hashed into its report entry, so that runs that differ say whether a rank's
+  // samples or the reduction did. Costs rank 0 a pass over its film inside the frame.
+  const char* hash_env = std::getenv("PATHBENCH_RANK_FILM_HASH");
+  const std::string part_hash =
+      hash_env && std::string(hash_env) == "1" && s.device == Device::Cpu ? film_hash(film) : std::string();
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
   const double wait_seconds = std::chrono::duration<double>(r0 - t0).count() - mine.seconds;
@@ -266,8 +276,10 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
       w.reduce_film_rows(film, send);
     } else {
       // A static split's ranks each hold every pixel (MPI_Reduce); dynamic chunks' ranks hold
-      // bands of rows, and only those travel.
-      balance == Balance::Dynamic ? w.reduce_film_rows(film, rows) : w.reduce_film(film);
+      // bands of rows, and only those travel, from the ranks rank 0 granted samples: a rank
+      // that traced nothing (a CPU rank beside a GPU that took the frame) sends nothing and
+      // rank 0 waits for no collective (issue 30).
+      balance == Balance::Dynamic ? w.send_film_rows(film, rows, senders) : w.reduce_film(film);
     }
     mpi_seconds = since(m0);
   });
@@ -278,6 +290,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   nlohmann::json entry = rank_entry(w.rank(), w.host(), s, mine, gpu_index, samples, chunks, busy_wall);
   // Where this rank's frame went: tracing (its tracer calls), waiting (chunk requests, the
   // slowest rank), and the reduction (bound check, NCCL, the download, MPI).
+  if (!part_hash.empty()) entry["film_hash"] = part_hash;  // this rank's film before the reduction
   entry["trace_seconds"] = mine.seconds;
   entry["wait_seconds"] = std::max(0.0, wait_seconds);
   entry["reduce_seconds"] = reduce_seconds;

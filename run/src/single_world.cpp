@@ -32,6 +32,7 @@ void World::barrier() {}
 std::string World::announce(const std::string& message) { return message; }
 void World::reduce_film(Film&) {}
 void World::reduce_film_rows(Film&, const std::vector<RowRange>&) {}
+void World::send_film_rows(Film&, const std::vector<RowRange>&, const std::vector<int>&) {}
 bool World::can_dispense() const { return true; }
 int World::end(int code) { return code; }  // no MPI: nothing to end
 
@@ -46,7 +47,9 @@ UnitRange SampleDispenser::next(double, uint64_t) {
   return s;
 }
 void SampleDispenser::abort() { impl_->next = impl_->units; }
+void SampleDispenser::start() {}
 void SampleDispenser::finish() {}
+std::vector<int> SampleDispenser::ranks_granted() const { return {}; }
 uint64_t SampleDispenser::chunks_granted() const { return impl_->next > 0 ? 1 : 0; }
 
 }  // namespace pb::run

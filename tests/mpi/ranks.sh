@@ -24,6 +24,9 @@
 #                 memory), static and dynamic: the one-process image byte for byte
 # tcp_killed_rank a rank SIGKILLed over TCP alone: the run ends within 30 s with a message
 #                 naming the lost process, no image
+# idle_rank       3 ranks, dynamic, a frame of 16 units (8 rows x 2 spp) and chunks of at least
+#                 8 (a rank's probe): a rank is granted nothing, sends nothing (send_film_rows),
+#                 and the image is still one process's byte for byte
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -35,7 +38,9 @@ mkdir -p "$dir"
 cd "$dir" || exit 1
 # CI runs as root on 2 cores.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-mpi="$mpiexec --oversubscribe --bind-to none"
+# PB_MPI_ARGS: more mpirun options (two_nodes.sh: the hostfile and launch agent of its
+# namespaces); PB_TCP_ARGS: the TCP-only options in place of the loopback's.
+mpi="$mpiexec --oversubscribe --bind-to none ${PB_MPI_ARGS:-}"
 base="render --quiet --width 64 --height 64 --bounces 2"
 frame="$base --spp 24"
 fail() { echo "ranks.sh $case_name: $*" >&2; exit 1; }
@@ -69,7 +74,7 @@ killed() {
   refused "$status" "." x.pfm
 }
 # Between nodes there is no shared memory: TCP alone, on the loopback interface here.
-tcp="--mca btl self,tcp --mca btl_tcp_if_include lo --mca pml ob1 --mca osc ^sm,rdma"
+tcp=${PB_TCP_ARGS:-"--mca btl self,tcp --mca btl_tcp_if_include lo --mca pml ob1 --mca osc ^sm,rdma"}
 
 case $case_name in
   tcp)
@@ -119,6 +124,14 @@ case $case_name in
       [ -n "$(film_hash one.json)" ] && [ "$(film_hash one.json)" = "$(film_hash $balance.json)" ] ||
         fail "film_hash of $n ranks ($(film_hash $balance.json)) is not one process's ($(film_hash one.json))"
     done ;;
+  idle_rank)
+    tiny="render --quiet --width 8 --height 8 --bounces 2 --spp 2"
+    "$pb" $tiny --out one.pfm --report one.json || fail "one-process render failed"
+    run -np 3 "$pb" $tiny --balance dynamic --out x.pfm --report x.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    same x.pfm
+    [ "$(film_hash one.json)" = "$(film_hash x.json)" ] || fail "film_hash differs"
+    grep -q '"samples": 0,' x.json || fail "no rank was idle: the case no longer tests a rank without rows" ;;
   mpmd_threads)
     one
     run -np 1 "$pb" $frame --balance dynamic --threads 2 --out mpmd.pfm : -np 1 "$pb" $frame --balance dynamic --threads 1 --out mpmd.pfm

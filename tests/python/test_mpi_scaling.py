@@ -31,6 +31,8 @@ FAKE_PATHBENCH = textwrap.dedent("""\
     if ranks == 2 and str(n) == os.environ.get("FAKE_BAD_RUN"):
         if os.environ.get("FAKE_BAD_KIND") == "film":
             image, film = image[:-1] + b"\\1", "fnv1a64:0000000000000002"
+        elif os.environ.get("FAKE_BAD_KIND") == "film_only":  # sums below the image's resolution
+            film = "fnv1a64:0000000000000002"
         else:
             image = image + b"\\n"  # the file differs, the film does not
     open(get("--out"), "wb").write(image)
@@ -105,6 +107,9 @@ def test_identical_runs_pass_and_history_document_records(fakes, tmp_path):
     # median run's image alone: a different first run (the fastest) went unseen.
     ("4", "film", "the film differs (film_hash)"),
     ("5", "file", "the image file differs while the film is the same"),
+    # Seen once on the 2 x H100 host (3 CPU ranks, b23764b): the film's sums differed, the
+    # image's bytes did not.
+    ("6", "film_only", "the film differs while the image file is the same"),
 ])
 def test_any_repetition_that_differs_is_reported(fakes, tmp_path, run_no, kind, why):
     r, doc, _ = study(fakes, tmp_path, FAKE_BAD_RUN=run_no, FAKE_BAD_KIND=kind)
@@ -113,6 +118,8 @@ def test_any_repetition_that_differs_is_reported(fakes, tmp_path, run_no, kind, 
     assert two["identical"] is False and two["difference"] == why
     assert f"NOT IDENTICAL: strong-cpu 64x64x32 on 2 ranks: {why}" in r.stdout
     assert strong(doc, 1)["identical"] is True
+    assert len(two["film_hash_all"]) == 3 and two["base_film_hash"] == "fnv1a64:0000000000000001"
+    assert (two["film_hash_all"][int(run_no) - 4] != two["base_film_hash"]) == (kind != "file")
 
 
 def test_gpu_counts():

@@ -129,7 +129,8 @@ INSTANTIATE_TEST_SUITE_P(Isas, TinyIsa, ::testing::Values(Isa::Avx2, Isa::Avx512
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 // Every ray of `rays` through the tiny test (with Embree where it is unsure) and through
-// Embree alone, as closest hit and as occlusion (up to its tfar): the same answers.
+// Embree alone (one rtcIntersect1 / rtcOccluded1 a ray), as closest hit and as occlusion
+// (up to its tfar): the same answers.
 // Returns the share of rays the test alone leaves to Embree, the larger of the two
 // queries' (each counted over the rays cast for it).
 template <int W>
@@ -181,8 +182,10 @@ double check_rays(const cpu::BatchKernels& k, const cpu::TinyScene& tiny, const 
     cpu::tiny_closest<W>(k, tiny, embree, ctx, sc, b, W, prim);
     cpu::tiny_occluded<W>(k, tiny, embree, ctx, so, sb, W, blocked);
     for (int i = 0; i < W; ++i) {
-      const uint32_t expect = cpu::packet_triangle(embree, a, i);
-      const bool expect_blocked = sa.tfar[i] < 0.0f;
+      // Embree's answer for the ray alone (trace_path's single-ray queries): a packet's
+      // (a, sa) differs for some rays at edges (AnswersDoNotDependOnPacketMates).
+      const uint32_t expect = cpu::closest_triangle(embree, ctx, rays[base + i].ray);
+      const bool expect_blocked = cpu::occluded(embree, ctx, rays[base + i].ray, rays[base + i].tfar);
       if (prim[i] != expect || blocked[i] != expect_blocked) {
         if (++wrong <= 5)
           ADD_FAILURE() << "ray " << base + i << ": triangle " << prim[i] << " (Embree " << expect << "), blocked "
@@ -258,6 +261,85 @@ TEST_P(TinyIsa, AxisParallelRaysSameAnswersAsEmbree) {
     if (k.lanes == 16) check_rays<16>(k, *tiny, *embree, rays);
     else check_rays<8>(k, *tiny, *embree, rays);
   }
+}
+
+// A ray's answer depends on the ray alone, not on its packet: the tracers pack rays by
+// pixel and sample (the pixel strategy: W consecutive samples of a pixel from the block's
+// first sample, so a rank's share of the samples decides which rays share a packet; the
+// wavefront: whatever is live), and the lanes past the active ones hold earlier rays. Each
+// ray (aimed at edges and vertices: the ones the test leaves to Embree) goes through the
+// tracers' closest_hits / shadows_blocked at every lane position, with random packet mates
+// and with garbage (NaN, infinities, huge and zero rays) in the inactive lanes, and must get
+// what one rtcIntersect1 / rtcOccluded1 gives it (trace_path's answer) every time.
+template <int W>
+void check_packet_mates(const cpu::BatchKernels& k, const Scene& scene, EmbreeLayout layout) {
+  const auto embree = cpu::make_embree_scene(scene, true, layout);
+  const auto tiny = cpu::tiny_scene_for(*embree, scene.view(), &k);
+  ASSERT_NE(tiny, nullptr);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  const std::vector<TestRay> rays = ray_mix(scene, 1500, true, 21), mates = ray_mix(scene, 300, false, 22);
+  std::mt19937 rng(23);
+  const float nan = std::nanf(""), inf = kInfinity;
+  const float garbage[][6] = {{nan, nan, nan, nan, nan, nan}, {inf, -inf, inf, -inf, inf, -inf},
+                              {1e30f, -1e30f, 1e30f, 1e-30f, 1e30f, -1e-30f}, {0, 0, 0, 0, 0, 0}};
+  size_t checked = 0, wrong = 0;
+  alignas(64) RTCRayHitNt<W> hp;
+  alignas(64) RTCRayNt<W> sp;
+  cpu::init_packet_constants(hp.ray);
+  cpu::init_packet_constants(sp);
+  cpu::reset_packet(hp);
+  cpu::reset_packet(sp);
+  for (size_t r = 0; r < rays.size(); ++r) {
+    const TestRay& x = rays[r];
+    const bool shadow = x.tfar == 1.0f;
+    const uint32_t expect_prim = shadow ? 0 : cpu::closest_triangle(*embree, ctx, x.ray);
+    const bool expect_blocked = shadow && cpu::occluded(*embree, ctx, x.ray, 1.0f);
+    const int lane = int(r % W);
+    for (int variant = 0; variant < 6; ++variant) {
+      // Variants 0-3: the ray alone at `lane` among active mates before it, garbage after;
+      // 4-5: random mates in every lane, every one active.
+      alignas(64) float soa[6][W];
+      const int n = variant < 4 ? lane + 1 : W;
+      for (int i = 0; i < W; ++i) {
+        const TestRay& m = mates[rng() % mates.size()];
+        const float v[6] = {m.ray.o.x, m.ray.o.y, m.ray.o.z, m.ray.d.x, m.ray.d.y, m.ray.d.z};
+        for (int j = 0; j < 6; ++j) soa[j][i] = i < n ? v[j] : garbage[variant % 4][j];
+      }
+      const float v[6] = {x.ray.o.x, x.ray.o.y, x.ray.o.z, x.ray.d.x, x.ray.d.y, x.ray.d.z};
+      for (int j = 0; j < 6; ++j) soa[j][lane] = v[j];
+      const float* arrays[6] = {soa[0], soa[1], soa[2], soa[3], soa[4], soa[5]};
+      uint32_t prim[W];
+      bool blocked[W];
+      bool ok;
+      if (shadow) {
+        cpu::shadows_blocked<W>(k, tiny.get(), *embree, ctx, arrays, sp, n, blocked);
+        ok = blocked[lane] == expect_blocked;
+      } else {
+        cpu::closest_hits<W>(k, tiny.get(), *embree, ctx, arrays, hp, n, prim);
+        ok = prim[lane] == expect_prim;
+      }
+      ++checked;
+      if (!ok && ++wrong <= 5)
+        ADD_FAILURE() << "ray " << r << " at lane " << lane << " of " << n << " (variant " << variant << "): "
+                      << (shadow ? "blocked " + std::to_string(blocked[lane]) : "triangle " + std::to_string(prim[lane]))
+                      << ", alone " << (shadow ? std::to_string(expect_blocked) : std::to_string(expect_prim));
+    }
+  }
+  EXPECT_EQ(wrong, 0u) << "of " << checked << " packings";
+}
+
+TEST_P(TinyIsa, AnswersDoNotDependOnPacketMates) {
+  if (!cpu::cpu_supports(GetParam()) || !__builtin_cpu_supports("fma"))
+    GTEST_SKIP() << "this CPU lacks " << to_string(GetParam()) << " (or FMA); that tiny-scene test cannot run here";
+  const cpu::BatchKernels& k = *cpu::batch_kernels(GetParam());
+  const Scene scenes[] = {load_scene("paper-cornell"), random_icosahedron(5, 0x1p-10f)};
+  for (const Scene& scene : scenes)
+    for (EmbreeLayout layout : {EmbreeLayout::Quads, EmbreeLayout::Triangles}) {
+      SCOPED_TRACE(scene.name + ", " + to_string(layout));
+      if (k.lanes == 16) check_packet_mates<16>(k, scene, layout);
+      else check_packet_mates<8>(k, scene, layout);
+    }
 }
 
 TEST(TinyScene, OnlyForTinyScenes) {

@@ -69,6 +69,12 @@ class World {
   // overflow throws std::overflow_error on rank 0 after every rank's rows arrived).
   // Sums and counts are exact, so the film equals reduce_film's.
   void reduce_film_rows(Film& film, const std::vector<RowRange>& mine);
+  // Not collective: the same where rank 0 knows which ranks hold rows (dynamic chunks: the
+  // dispenser's grants). Each other rank with rows sends them (its film's size, scale and
+  // variance with them), a rank without rows does nothing at all, and rank 0 receives from
+  // `senders` (its argument alone counts) only: a CPU rank that traced nothing beside a GPU
+  // costs the frame no collective (issue 30). The rules and the film are reduce_film_rows's.
+  void send_film_rows(Film& film, const std::vector<RowRange>& mine, const std::vector<int>& senders);
   // Whether rank 0 can serve a SampleDispenser from a thread (MPI gave at least
   // MPI_THREAD_SERIALIZED); otherwise ranks split the samples statically.
   bool can_dispense() const;
@@ -116,9 +122,15 @@ class SampleDispenser {
   // This rank failed: hand out nothing more, so every rank reaches the next agreement
   // within one chunk.
   void abort();
+  // Rank 0's server starts answering here, not when constructed: constructed before the
+  // frame's clock (its thread started then), started after the ranks' common start (the
+  // thread calls MPI only from here on, so that a world of MPI_THREAD_SERIALIZED never has
+  // two threads in MPI). Idempotent; next() starts it too.
+  void start();
   // Collective (rank 0 waits for every rank's last request).
   void finish();
   uint64_t chunks_granted() const;  // rank 0: chunks handed out in all
+  std::vector<int> ranks_granted() const;  // rank 0: the other ranks granted any units, ascending
   struct Impl;
 
  private:
