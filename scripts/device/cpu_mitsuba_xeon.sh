@@ -31,7 +31,11 @@ for b in $builds; do
   chmod +x $T/bin/pathbench-$b
 done
 { lscpu; echo; grep -o 'avx512[a-z_0-9]*' /proc/cpuinfo | sort -u | tr '\n' ' '; echo; uptime; } > "$OUT/host2.txt"
-export PYTHONPATH=$T/mi DRJIT_LIBLLVM_PATH=$T/libLLVM.so.19.1 PYTHONUNBUFFERED=1
+# The host has no pathbench Python module, which the tool's Mitsuba export needs: $C/pymod, where
+# carried, holds a stand-in `pathbench` package whose export_mitsuba copies an export made on the
+# development host by the real module (pathbench.export_mitsuba(load_scene("paper-cornell"), dir,
+# 256, 256, bounces=2)) into the tool's folder.
+export PYTHONPATH=$T/mi${C:+$([ -d $C/pymod ] && echo :$C/pymod)} DRJIT_LIBLLVM_PATH=$T/libLLVM.so.19.1 PYTHONUNBUFFERED=1
 export LD_LIBRARY_PATH=$T/llvmdeps  # Mitsuba's process: none of these is an Embree
 python3 -c "import mitsuba as mi; mi.set_variant('llvm_ad_rgb'); print('mitsuba', mi.__version__)" || exit 3
 # main's build as --baseline where it was carried (the carry limit may leave it out: then the
