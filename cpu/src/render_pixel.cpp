@@ -136,10 +136,10 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
       bool candidate[W];
       k.final_vertex_candidates(job.scene, at_final, candidate);
       // The emitter queries' shadow rays: one tiny test for all of them where there is one
-      // and they are enough to pay for it (tiny_final_min; a proven answer is Embree's), each
-      // unsure one (and every one otherwise) through the single-ray rtcOccluded1 this step
-      // always made, so every ray gets the answer it got before (docs/notes/cpu-log.md,
-      // 2026-11-27).
+      // and they are enough to pay for it (tiny_final_min; a proven answer is Embree's, and
+      // tiny_occluded asks the single-ray rtcOccluded1 for each unsure one), otherwise that
+      // rtcOccluded1 for every one, as this step always did, so every ray gets the answer it
+      // got before (docs/notes/cpu-log.md, 2026-11-27).
       ShadowQuery<float> q[W];
       uint32_t of[W];  // the query's sample
       int n_q = 0;
@@ -153,17 +153,14 @@ PB_CPU_FLATTEN void trace_samples_batched(const TraceJob& job, const BatchKernel
       if (n_q > 0) {
         (depth == 0 ? local.rays.camera : local.rays.shadow) += uint64_t(n_q);  // count_ray, per query
         bool blocked[W];
-        uint32_t unsure = (uint32_t(1) << n_q) - 1;
         if (tiny && n_q >= tiny_final_min(*tiny)) {
           PB_STAGE(kShadow);
           float* rays[6];
           packet_arrays(packets.shadow, rays);
-          unsure &= k.tiny_occluded(*tiny, rays, packets.shadow.tfar, blocked);  // tfar: 1 (PixelPackets)
-        }
-        for (; unsure != 0; unsure &= unsure - 1) {
+          tiny_occluded<W>(k, *tiny, job.embree, ctx, rays, packets.shadow, n_q, blocked);  // tfar: 1 (PixelPackets)
+        } else {
           PB_STAGE(kShadowEmbree);
-          const int i = __builtin_ctz(unsure);
-          blocked[i] = occluded(job.embree, ctx, q[i].ray, 1.0f);
+          for (int i = 0; i < n_q; ++i) blocked[i] = occluded(job.embree, ctx, q[i].ray, 1.0f);
         }
         for (int i = 0; i < n_q; ++i)
           if (!blocked[i]) shadow_unoccluded(st[of[i]], q[i]);

@@ -236,6 +236,11 @@ inline std::unique_ptr<TinyScene> tiny_scene_for(const EmbreeScene& e, const Sce
   return TinyScene::build(e, s, size_t(TinyScene::kTrianglesPerLane * k->lanes));
 }
 
+// Lane i of the six ray arrays (org x, y, z, dir x, y, z) as one ray.
+inline Ray<float> lane_ray(const float* const* rays, int i) {
+  return {{rays[0][i], rays[1][i], rays[2][i]}, {rays[3][i], rays[4][i], rays[5][i]}};
+}
+
 // The closest hits of the rays `rays` (six arrays of W: org x, y, z, dir x, y, z; lanes
 // [0, n) valid; W = k.lanes) with packet `p`'s tfar: the tiny test, and for each lane it
 // leaves unsure, Embree for that ray alone (rtcIntersect1, trace_path's query). Not Embree's
@@ -254,7 +259,7 @@ int tiny_closest(const BatchKernels& k, const TinyScene& t, const EmbreeScene& e
   PB_STAGE(kClosestEmbree);
   for (uint32_t u = unsure; u != 0; u &= u - 1) {
     const int i = __builtin_ctz(u);
-    prim[i] = closest_triangle(e, ctx, Ray<float>{{rays[0][i], rays[1][i], rays[2][i]}, {rays[3][i], rays[4][i], rays[5][i]}});
+    prim[i] = closest_triangle(e, ctx, lane_ray(rays, i));
   }
   return __builtin_popcount(unsure);
 }
@@ -270,8 +275,7 @@ int tiny_occluded(const BatchKernels& k, const TinyScene& t, const EmbreeScene& 
   PB_STAGE(kShadowEmbree);
   for (uint32_t u = unsure; u != 0; u &= u - 1) {
     const int i = __builtin_ctz(u);
-    blocked[i] = occluded(e, ctx, Ray<float>{{rays[0][i], rays[1][i], rays[2][i]}, {rays[3][i], rays[4][i], rays[5][i]}},
-                          p.tfar[i]);
+    blocked[i] = occluded(e, ctx, lane_ray(rays, i), p.tfar[i]);
   }
   return __builtin_popcount(unsure);
 }
