@@ -87,18 +87,30 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
   block_stats_add(&ctr->stats, n_bounce, n_shadow, n_paths);
 }
 
+// The counts k_pixel is compiled for (float, watertight): 3 and kPixelLatencyBlocks for every
+// layout, 5 too for the wide, leaves and binary layouts (kWideLatencyBlocks,
+// kLeavesParkedBlocks, the binary BVH's opt-in); the parked path state for the leaves layout
+// at every count but kPixelLatencyBlocks and the binary BVH's at 5 and 8. run_pixel
+// dispatches on these, pixel_blocks and pixel_occupancy choose within them.
+constexpr bool compiled_for_five_blocks(int kind) {
+  return kind == int(TraversalKind::Wide) || kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Binary);
+}
+constexpr bool parked_compiled(int kind, int blocks) {
+  return (kind == int(TraversalKind::Leaves) && blocks != kPixelLatencyBlocks) ||
+         (kind == int(TraversalKind::Binary) && blocks >= 5);
+}
+static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kPixelLatencyBlocks == 8,
+              "the counts compiled: 3, 5 and 8");
+
 // The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy).
 PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
   const bool wide = g.bvh.kind == TraversalKind::Wide;
-  // The leaves layout (kLeavesPixelBlocks) and the binary BVH are compiled for 5 blocks too.
-  const bool five = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Binary;
   const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   const std::string v = env ? env : "auto";
   if (v != "auto") {
-    bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) || (five && v == "5");
-    if (wide)
-      for (int n : kWidePixelBlocks) ok = ok || v == std::to_string(n);
+    const bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) ||
+                    (compiled_for_five_blocks(int(g.bvh.kind)) && v == "5");
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
                                    "auto, 3, 5 or 8; the leaves layout and the binary BVH: also 5)", v,
@@ -114,14 +126,13 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   PixelOccupancy o = pixel_blocks(g);
-  const bool leaves = g.bvh.kind == TraversalKind::Leaves, binary = g.bvh.kind == TraversalKind::Binary;
+  const bool leaves = g.bvh.kind == TraversalKind::Leaves;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
   const std::string v = env ? env : "auto";
   if (v == "auto") o.parked = leaves;
   else if (v == "0" || v == "1") o.parked = v == "1";
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
-  // Compiled for the leaves layout (every count but 8) and the binary BVH's 5 and 8 blocks.
-  if (o.parked && !((leaves && o.min_blocks != 8) || (binary && o.min_blocks >= 5))) o.parked = false;
+  if (o.parked && !parked_compiled(int(g.bvh.kind), o.min_blocks)) o.parked = false;
   const char* blocks = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
     o.min_blocks = kLeavesParkedBlocks;
@@ -155,31 +166,16 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
         constexpr int B = decltype(kind)::value;
         auto at = [&](auto blocks) {
           constexpr int N = decltype(blocks)::value;
-          // The parked path state (pixel_occupancy says where): the leaves layout, the binary BVH at 5 and 8.
-          if constexpr ((B == int(TraversalKind::Leaves) && N != 8) || (B == int(TraversalKind::Binary) && N >= 5)) {
+          if constexpr (parked_compiled(B, N)) {  // pixel_occupancy says where it runs
             if (parked) return variance ? go(k_pixel<true, K, float, true, B, N, true>) : go(k_pixel<false, K, float, true, B, N, true>);
           }
           variance ? go(k_pixel<true, K, float, true, B, N>) : go(k_pixel<false, K, float, true, B, N>);
         };
-        using I = std::integral_constant<int, 3>;
-        if constexpr (B == int(TraversalKind::Wide)) {  // kWidePixelBlocks
-          static_assert(kWideLatencyBlocks == 5 && kPixelLatencyBlocks == 8, "kWidePixelBlocks: 3, 5, 8");
-          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
-          else if (min_blocks == 8) at(std::integral_constant<int, 8>{});
-          else at(I{});
-        } else if constexpr (B == int(TraversalKind::Leaves)) {  // kLeavesPixelBlocks
-          static_assert(kLeavesParkedBlocks == 5, "kLeavesPixelBlocks: 3, 5, 8");
-          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
-          else if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
-          else at(I{});
-        } else if constexpr (B == int(TraversalKind::Binary)) {
-          if (min_blocks == 5) at(std::integral_constant<int, 5>{});
-          else if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
-          else at(I{});
-        } else {
-          if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
-          else at(I{});
+        if constexpr (compiled_for_five_blocks(B)) {
+          if (min_blocks == 5) return at(std::integral_constant<int, 5>{});
         }
+        if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
+        else at(std::integral_constant<int, 3>{});
       });
   });
   FrameResult r;

@@ -40,7 +40,7 @@ struct ShadowUse {
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
 // and the megakernel waits on memory (more warps hide it); below, it is issue bound.
 // PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 (5 too for the leaves and binary layouts) overrides it (a bad value: InputError); the wide
-// BVH's megakernel is compiled for more counts (kWidePixelBlocks) and takes any of them.
+// BVH's megakernel is compiled for 5 too (pixel.cu: compiled_for_five_blocks).
 struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
@@ -64,16 +64,14 @@ constexpr int kPixelLatencyBlocks = 8;
 // blocks 103.80 (binary at 8: 43.03; docs/notes/gpu-log.md, "Wide BVH: own occupancy, short
 // stack"). Measured with 4 and 6 compiled too; kept to 3, 5 and 8 (each count is one more
 // megakernel per material set and variance flag in pixel.cu's compile).
-constexpr int kWidePixelBlocks[] = {3, 5, 8};
 constexpr int kWideLatencyBlocks = 5;
-// The leaves layout's megakernel is compiled for 3, 5 and 8 blocks (PATHBENCH_GPU_PIXEL_BLOCKS).
+// The leaves layout's megakernel is compiled for 3, 5 and 8 blocks too (PATHBENCH_GPU_PIXEL_BLOCKS).
 // With the path state parked in shared memory (PixelOccupancy::parked, pixel.cu's ParkedPath)
 // it needs 64 registers and spills nothing (in registers: 80 and 28 / 16 bytes spilled), and
 // auto gives it kLeavesParkedBlocks. H100, paper-cornell 256x256x800 nee, same films
 // (docs/notes/gpu-log.md, "The path state parked in shared memory"): in registers at 3
 // blocks 10.645 ms, at 4 10.749, at 5 10.454; parked at 3 (64 registers: 4 blocks run)
 // 10.245, parked at 5 (48 registers, 100 / 84 bytes spilled) 10.131.
-constexpr int kLeavesPixelBlocks[] = {3, 5, 8};
 constexpr int kLeavesParkedBlocks = 5;
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 
