@@ -2,7 +2,7 @@
 # The GPU call of record, on the GPU host (one device call, under 10 minutes on an H100):
 # build, tests and sanitizers of this tree (scripts/device/run_on_device.sh), the committed bench JSON
 # (bench-paper-gpu.json, bench-raycast-gpu.json), paper-cornell-ico:8 and 2048x2048x1024
-# renders, an interleaved A/B (scripts/device/gpu_ab.sh) against a base made by reversing
+# renders, an interleaved A/B (scripts/device/gpu_ab.sh: renders and raw casts) against a base made by reversing
 # BASE_PATCH on a copy of this tree, and the roofline (scripts/device/gpu_roofline.sh) if time is
 # left. Everything goes to OUT_DIR; console output says what passed.
 #   scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]
@@ -40,7 +40,7 @@ else
   (cd $base && patch -s -R -p1 < "$patch_file") || { echo "the base patch does not reverse on this tree"; exit 1; }
 fi
 (cmake -S $base -B $base/build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF \
-   -DCMAKE_CUDA_ARCHITECTURES=90 > /dev/null 2>&1 && cmake --build $base/build-gpu -j 5 --target pathbench \
+   -DCMAKE_CUDA_ARCHITECTURES=90 > /dev/null 2>&1 && cmake --build $base/build-gpu -j 5 --target pathbench pathbench-bench \
    > "$out/base-build.log" 2>&1; echo "base build rc=$?") &
 OUT=$out bash scripts/device/run_on_device.sh build test sanitize > "$out/run_on_device.txt" 2>&1
 echo "build + test + sanitize rc=$?"
