@@ -129,6 +129,21 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   RenderSettings s = settings;
   std::unique_ptr<RankTracer> tracer;
   int gpu_index = -1;
+  // What a tracer measures to prepare the scene (the CPU's Embree layout under auto: a timed
+  // probe) is rank 0's on every rank (Tracer::measured): each rank probing for itself, beside
+  // the others' start, once picked another layout on one rank of three (a film differing in
+  // low bits, the same image bytes: issue 30, docs/mpi.md). CPU ranks beside GPUs trace the
+  // GPU's BVH and measure nothing.
+  const bool all_cpu = std::find(devices.begin(), devices.end(), "gpu") == devices.end();
+  std::string measured;
+  on_every_rank([&] {
+    if (all_cpu && w.root()) measured = cpu_tracer().measured(scene, s);
+  });
+  measured = w.all(measured)[0];
+  on_every_rank([&] {
+    if (all_cpu && !w.root() && !cpu_tracer().adopt_measured(scene, s, measured))
+      throw std::runtime_error(fmt::format("rank 0's measured choices cannot be read: '{}'", measured));
+  });
   on_every_rank([&] {
     // Before any other CUDA call (RankTracer's device check), so the rank's context is on its GPU.
     if (s.device == Device::Gpu) gpu_index = gpu_tracer().select_device(w.local_rank());
@@ -291,6 +306,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // Where this rank's frame went: tracing (its tracer calls), waiting (chunk requests, the
   // slowest rank), and the reduction (bound check, NCCL, the download, MPI).
   if (!part_hash.empty()) entry["film_hash"] = part_hash;  // this rank's film before the reduction
+  if (mine.extra.contains("embree_layout")) entry["embree_layout"] = mine.extra["embree_layout"];  // the layout it traced
   entry["trace_seconds"] = mine.seconds;
   entry["wait_seconds"] = std::max(0.0, wait_seconds);
   entry["reduce_seconds"] = reduce_seconds;

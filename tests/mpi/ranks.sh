@@ -27,6 +27,10 @@
 # idle_rank       3 ranks, dynamic, a frame of 16 units (8 rows x 2 spp) and chunks of at least
 #                 8 (a rank's probe): a rank is granted nothing, sends nothing (send_film_rows),
 #                 and the image is still one process's byte for byte
+# layout_agree    3 CPU ranks under --embree-layout auto: every rank traced rank 0's probed
+#                 layout, probe times and all (each rank once timed its own probe beside the
+#                 others' start: one rank of three picked triangles, a film other than one
+#                 process's with the same image bytes; issue 30), and the film is one process's
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -132,6 +136,24 @@ case $case_name in
     same x.pfm
     [ "$(film_hash one.json)" = "$(film_hash x.json)" ] || fail "film_hash differs"
     grep -q '"samples": 0,' x.json || fail "no rank was idle: the case no longer tests a rank without rows" ;;
+  layout_agree)
+    one
+    run -np 3 "$pb" $frame --balance static --out x.pfm --report x.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    same x.pfm
+    [ "$(film_hash one.json)" = "$(film_hash x.json)" ] || fail "film_hash differs"
+    python3 - x.json <<'EOF_PY' || fail "the ranks did not all trace rank 0's measured layout"
+import json, sys
+r = json.load(open(sys.argv[1]))
+ranks = r["ranks"]["per_rank"]
+assert len(ranks) == 3 and r["embree_layout"]["asked"] == "auto", r["embree_layout"]
+layouts = [e.get("embree_layout") for e in ranks]
+assert layouts[0] is not None and layouts[0]["probe_ns_per_ray"], layouts[0]
+for i, l in enumerate(layouts):
+    assert l == layouts[0], f"rank {i} traced {l}, rank 0 {layouts[0]}"
+print("ranks.sh layout_agree: every rank:", layouts[0]["used"], layouts[0]["probe_ns_per_ray"])
+EOF_PY
+    ;;
   mpmd_threads)
     one
     run -np 1 "$pb" $frame --balance dynamic --threads 2 --out mpmd.pfm : -np 1 "$pb" $frame --balance dynamic --threads 1 --out mpmd.pfm
