@@ -30,6 +30,9 @@ constexpr size_t kMaxProbedTriangles = size_t(1) << 16;
 // margin well above the probe's noise, so a loaded machine does not flip the answer.
 constexpr double kQuadsShareToWin = 0.9;
 constexpr int kRounds = 5;
+// Up to this many rounds while the share is within kCloseToTheLine of kQuadsShareToWin.
+constexpr int kMaxRounds = 25;
+constexpr double kCloseToTheLine = 0.1;
 constexpr uint32_t kCameraGrid = 48;      // 48 x 48 camera rays
 constexpr uint32_t kSurfaceRays = 2304;   // as many rays leaving surfaces, and shadow rays
 
@@ -114,7 +117,11 @@ LayoutChoice measure(const Scene& s, bool watertight, TrianglePairs& pairs) {
   trace_ns_per_ray(triangles, rays);  // warm-up: caches, lazily built parts
   trace_ns_per_ray(quads, rays);
   c.triangles_ns = c.quads_ns = std::numeric_limits<double>::infinity();
-  for (int round = 0; round < kRounds; ++round) {  // alternating, best round of each (load only adds time)
+  // Alternating, best round of each (load only adds time). Where the answer is close to the
+  // line after kRounds (a loaded machine: MPI ranks starting together), more rounds, so that a
+  // few slowed rounds do not decide it: every process of a run should get one answer.
+  for (int round = 0; round < kMaxRounds; ++round) {
+    if (round >= kRounds && std::abs(c.quads_ns / c.triangles_ns - kQuadsShareToWin) > kCloseToTheLine) break;
     const bool quads_first = round % 2 == 1;
     for (int k = 0; k < 2; ++k) {
       if ((k == 0) == quads_first) c.quads_ns = std::min(c.quads_ns, trace_ns_per_ray(quads, rays));

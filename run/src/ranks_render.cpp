@@ -60,6 +60,18 @@ int cpu_share(const std::vector<std::string>& local_devices) {
   return std::max(1, (hardware_threads() - gpus) / cpus);
 }
 
+// PATHBENCH_RANK_FILM_HASH (diagnostics, issue 30): 1 puts each CPU rank's own film hash
+// (before the reduction) in its report entry; unset, empty or 0: not. Anything else is refused.
+bool rank_film_hash_asked() {
+  const char* e = std::getenv("PATHBENCH_RANK_FILM_HASH");
+  const std::string v = e ? e : "";
+  if (v.empty() || v == "0") return false;
+  if (v == "1") return true;
+  throw InputError(fmt::format("PATHBENCH_RANK_FILM_HASH='{}': expected 1 (each CPU rank's film hash in its "
+                               "report entry) or 0",
+                               v));
+}
+
 int gpu_count() {
   return gpu_tracer().device_count();  // no context yet: the rank has not picked its GPU
 }
@@ -129,6 +141,8 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   RenderSettings s = settings;
   std::unique_ptr<RankTracer> tracer;
   int gpu_index = -1;
+  bool rank_film_hash = false;
+  on_every_rank([&] { rank_film_hash = rank_film_hash_asked(); });
   // What a tracer measures to prepare the scene (the CPU's Embree layout under auto: a timed
   // probe) is rank 0's on every rank (Tracer::measured): each rank probing for itself, beside
   // the others' start, once picked another layout on one rank of three (a film differing in
@@ -263,9 +277,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // PATHBENCH_RANK_FILM_HASH=1 (diagnostics, issue 30): each CPU rank's own film before the
   // reduction, hashed into its report entry, so that runs that differ say whether a rank's
   // samples or the reduction did. Costs rank 0 a pass over its film inside the frame.
-  const char* hash_env = std::getenv("PATHBENCH_RANK_FILM_HASH");
-  const std::string part_hash =
-      hash_env && std::string(hash_env) == "1" && s.device == Device::Cpu ? film_hash(film) : std::string();
+  const std::string part_hash = rank_film_hash && s.device == Device::Cpu ? film_hash(film) : std::string();
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
   const double wait_seconds = std::chrono::duration<double>(r0 - t0).count() - mine.seconds;

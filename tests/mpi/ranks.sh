@@ -31,6 +31,8 @@
 #                 layout, probe times and all (each rank once timed its own probe beside the
 #                 others' start: one rank of three picked triangles, a film other than one
 #                 process's with the same image bytes; issue 30), and the film is one process's
+# rank_film_hash  PATHBENCH_RANK_FILM_HASH=1: each CPU rank's own film hash in its report entry;
+#                 another value (yes) refused, exit 2, no image
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -154,6 +156,15 @@ for i, l in enumerate(layouts):
 print("ranks.sh layout_agree: every rank:", layouts[0]["used"], layouts[0]["probe_ns_per_ray"])
 EOF_PY
     ;;
+  rank_film_hash)
+    export PATHBENCH_RANK_FILM_HASH=1
+    run -x PATHBENCH_RANK_FILM_HASH -np 2 "$pb" $frame --out x.pfm --report x.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    [ "$(grep -c '"film_hash": "fnv1a64:' x.json)" = 3 ] || fail "not a film hash for each rank and the frame"
+    export PATHBENCH_RANK_FILM_HASH=yes
+    run -x PATHBENCH_RANK_FILM_HASH -np 2 "$pb" $frame --out y.pfm
+    unset PATHBENCH_RANK_FILM_HASH
+    refused 2 "PATHBENCH_RANK_FILM_HASH='yes': expected 1" y.pfm ;;
   mpmd_threads)
     one
     run -np 1 "$pb" $frame --balance dynamic --threads 2 --out mpmd.pfm : -np 1 "$pb" $frame --balance dynamic --threads 1 --out mpmd.pfm
