@@ -177,6 +177,9 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     balance = std::all_of(devices.begin(), devices.end(), [&](const auto& d) { return d == devices[0]; })
                   ? Balance::Static : Balance::Dynamic;
   if (!w.can_dispense()) balance = Balance::Static;
+  // CPU ranks of the pixel strategy take whole batches of samples, aligned as one process's
+  // packets (kSampleBatch, ranks.h); every other rank traces each ray alone.
+  const uint32_t batch = all_cpu && s.strategy == Strategy::Pixel ? kSampleBatch : 1;
   // How the films come together: GPU ranks through NCCL where they can (gpu_reduce.h),
   // the rest through MPI. Set up (communicator, page-locked film on the GPU root) before
   // the frame's clock starts.
@@ -217,7 +220,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // Dynamic balancing only: rank 0 then serves it (its units: rows x samples). Made before
   // the frame's clock (rank 0's server thread), started after the common start.
   std::optional<SampleDispenser> dispenser;
-  if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
+  if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates, s.spp, batch);
 
   // 3. The frame: from a common start to the reduced film on rank 0.
   const nlohmann::json load0 = load_sample();
@@ -253,7 +256,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
           reduce_gpu_band(gred, tracer->device_film(), film, w.rank() == gred.root, first_row, rows);
         }
       } else if (balance == Balance::Static) {
-        const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
+        const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp, batch);
         if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
         double rate = rates.empty() ? 0.0 : rates[size_t(w.rank())];  // units per second in the last chunk
