@@ -12,7 +12,11 @@
 # against one GPU, interleaved, CACHE_REPS=5; bands: 2 GPU ranks reducing at the end against band
 # by band (PATHBENCH_REDUCE_BANDS), BANDS_REPS=3; repeat: CPU ranks' images against one
 # process's, REPEAT_RUNS=8 times each (the NOT IDENTICAL hunt); largemesh: the suite's large
-# mesh on one GPU and over the GPU ranks, PATHBENCH_DATA_DIR holding its mesh). TARGETS: what
+# mesh on one GPU and over the GPU ranks, PATHBENCH_DATA_DIR holding its mesh; hunt: issue 30's
+# film difference, HUNT_RUNS=30 runs of 3 CPU ranks at 256x256x800 (static: 272 + 272 + 256
+# samples a pixel) with each rank's film hash and Embree layout, against one process, and
+# HUNT_ICO_RUNS=3 of paper-cornell-ico:3 (above the tiny-scene limit: Embree's packets) at
+# 3 ranks, static and dynamic, against one process; hunt/ keeps a line per run). TARGETS: what
 # to build. PB=path: a pathbench built elsewhere (then `build` only checks that it runs).
 #   source .gpu-deps/unpack.sh is done here (pack-deps.sh --mpi); ../shared/gpu-host/README.md.
 set -uo pipefail
@@ -181,7 +185,10 @@ if has cache || has bands; then
 fi
 if has scaling; then
   rec=(); [ "${RECORD:-0}" = 1 ] && rec=(--record ${PATHBENCH_SOURCE_COMMIT:+--commit "$PATHBENCH_SOURCE_COMMIT"})
+  # Each CPU rank's film hash (before the reduction) in the study's JSON (rank_film_hashes_all).
+  export PATHBENCH_RANK_FILM_HASH=1
   PYTHONUNBUFFERED=1 python3 tools/mpi_scaling.py --pathbench $PB --mpirun "$MPIRUN" --gpus "$gpus" \
+      --mpi-arg=-x --mpi-arg=PATHBENCH_RANK_FILM_HASH \
       --cpu-ranks "${CPU_RANKS-1,2,4}" --reps "${SCALING_REPS:-3}" --hybrid-rounds "${HYBRID_ROUNDS:-${REPS:-5}}" \
       --out-dir "$OUT/scaling" "${rec[@]}" > "$OUT/scaling.txt" 2>&1
   log "scaling: $(grep -E '^\||NOT IDENTICAL|recorded' "$OUT/scaling.txt")"
@@ -209,6 +216,56 @@ if has repeat; then
   done
   log "repeat: $diff of $total CPU-rank runs (256x256x800, -np 2 and 4, static and dynamic) differ from one process"
   rm -f "$OUT"/repeat/*.pfm
+fi
+if has hunt; then
+  # Issue 30's film difference: 3 CPU ranks (static, the study's split and threads), each
+  # run's film hash, each rank's own film hash and traced Embree layout, and rank 0's layout
+  # probe (the layout every rank traces), against one CPU process; then a scene above the
+  # tiny-scene limit (Embree's packets answer the pixel strategy's rays: the ranks' samples
+  # are whole batches of 16), static and dynamic.
+  mkdir -p "$OUT/hunt"
+  export PATHBENCH_RANK_FILM_HASH=1
+  f="render --quiet --width 256 --height 256 --spp 800 --bounces 2 --device cpu"
+  $PB $f --out "$OUT/hunt/one.pfm" --report "$OUT/hunt/one.json"
+  line() {  # REPORT: film hash, per-rank film hashes, per-rank layouts, rank 0's probe (quads/triangles)
+    python3 - "$1" <<'EOF_PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+ranks = (r.get("ranks") or {}).get("per_rank", [])
+lay = r.get("embree_layout") or {}
+p = lay.get("probe_ns_per_ray") or {}
+ratio = f"{p['quads'] / p['triangles']:.3f}" if p.get("triangles") else "-"
+print(r["film_hash"], ",".join(str(e.get("film_hash")) for e in ranks) or "-",
+      ",".join(str((e.get("embree_layout") or {}).get("used")) for e in ranks) or lay.get("used"), "probe", ratio,
+      "spp", ",".join(f"{e['samples_per_pixel']:g}" for e in ranks) or "-")
+EOF_PY
+  }
+  ref=$(line "$OUT/hunt/one.json" | cut -d' ' -f1); refimg=$(sha256sum < "$OUT/hunt/one.pfm")
+  echo "one $(line "$OUT/hunt/one.json")" > "$OUT/hunt/runs.txt"
+  diff=0; runs=${HUNT_RUNS:-30}
+  for i in $(seq 1 $runs); do
+    mpi -x PATHBENCH_RANK_FILM_HASH -np 3 $PB $f --balance static --out "$OUT/hunt/x.pfm" --report "$OUT/hunt/x.json"
+    l=$(line "$OUT/hunt/x.json"); echo "np3 $i $l" >> "$OUT/hunt/runs.txt"
+    if [ "${l%% *}" != "$ref" ] || [ "$(sha256sum < "$OUT/hunt/x.pfm")" != "$refimg" ]; then
+      diff=$((diff + 1)); cp "$OUT/hunt/x.json" "$OUT/hunt/diff-$i.json"; log "hunt $i: DIFFERENT: $l (one process: $ref)"
+    fi
+  done
+  log "hunt: $diff of $runs runs of 3 CPU ranks (256x256x800, static) differ from one process ($ref); $(grep -c 'triangles' "$OUT/hunt/runs.txt") traced triangles; rank 0's probe quads/triangles $(awk '/^np3/ {print $7}' "$OUT/hunt/runs.txt" | sort -n | sed -n '1p;$p' | tr '\n' ' ')(min, max)"
+  g="render --quiet --width 256 --height 256 --spp 100 --bounces 2 --device cpu --scene paper-cornell-ico:3"
+  $PB $g --out "$OUT/hunt/ico1.pfm" --report "$OUT/hunt/ico1.json"
+  ref=$(line "$OUT/hunt/ico1.json" | cut -d' ' -f1); n=0; d=0
+  for i in $(seq 1 ${HUNT_ICO_RUNS:-3}); do
+    for bal in static dynamic; do
+      mpi -x PATHBENCH_RANK_FILM_HASH -np 3 $PB $g --balance $bal --out "$OUT/hunt/x.pfm" --report "$OUT/hunt/x.json"
+      l=$(line "$OUT/hunt/x.json"); echo "ico3 $bal $i $l" >> "$OUT/hunt/runs.txt"; n=$((n + 1))
+      if [ "${l%% *}" != "$ref" ] || ! cmp -s "$OUT/hunt/ico1.pfm" "$OUT/hunt/x.pfm"; then
+        d=$((d + 1)); log "hunt ico:3 $bal $i: DIFFERENT: $l (one process: $ref)"
+      fi
+    done
+  done
+  log "hunt: paper-cornell-ico:3 256x256x100, 3 CPU ranks (static 48 + 32 + 20 a pixel, and dynamic): $d of $n differ from one process ($ref)"
+  unset PATHBENCH_RANK_FILM_HASH
+  rm -f "$OUT"/hunt/*.pfm
 fi
 if has largemesh; then
   # The suite's large mesh (13.3 M triangles, Loop-subdivided armadillo) on one GPU and over

@@ -165,6 +165,9 @@ def entry(kind: str, frame, n: int, runs: list[dict], base: list[dict] | None, t
          # PATHBENCH_RANK_FILM_HASH=1 in the ranks' environment: each CPU rank's film before the reduction.
          "rank_film_hashes_all": [[p.get("film_hash") for p in (r["report"].get("ranks") or {}).get("per_rank", [])]
                                   for r in runs],
+         # The Embree layout each CPU rank traced (rank 0's probe on every rank since issue 30's fix).
+         "rank_layouts_all": [[(p.get("embree_layout") or {}).get("used")
+                               for p in (r["report"].get("ranks") or {}).get("per_rank", [])] for r in runs],
          "rays_per_second": report["rays"]["total"] / t if t > 0 else None,
          "film_hash": m["film_hash"],
          "load_balance": ranks.get("load_balance"), "parallel_efficiency": ranks.get("parallel_efficiency"),

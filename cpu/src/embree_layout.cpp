@@ -30,6 +30,9 @@ constexpr size_t kMaxProbedTriangles = size_t(1) << 16;
 // margin well above the probe's noise, so a loaded machine does not flip the answer.
 constexpr double kQuadsShareToWin = 0.9;
 constexpr int kRounds = 5;
+// Up to this many rounds while the share is within kCloseToTheLine of kQuadsShareToWin.
+constexpr int kMaxRounds = 25;
+constexpr double kCloseToTheLine = 0.1;
 constexpr uint32_t kCameraGrid = 48;      // 48 x 48 camera rays
 constexpr uint32_t kSurfaceRays = 2304;   // as many rays leaving surfaces, and shadow rays
 
@@ -87,20 +90,25 @@ double trace_ns_per_ray(const EmbreeScene& e, const ProbeRays& r) {
   return std::chrono::duration<double, std::nano>(t1 - t0).count() / double(r.closest.size() + r.shadow.size());
 }
 
+// Every reason the probe gives (measure), so that a remembered choice keeps a static string.
+constexpr const char* kReasons[] = {"no triangles", "over 65536 triangles: not probed",
+                                    "fewer than 90% of the triangles pair up", "quads measured faster",
+                                    "quads not measured clearly faster"};
+
 LayoutChoice measure(const Scene& s, bool watertight, TrianglePairs& pairs) {
   LayoutChoice c;
   if (s.triangles.empty()) {
-    c.reason = "no triangles";
+    c.reason = kReasons[0];
     return c;
   }
   if (s.triangles.size() > kMaxProbedTriangles) {
-    c.reason = "over 65536 triangles: not probed";
+    c.reason = kReasons[1];
     return c;
   }
   pairs = pair_triangles(s);
   c.paired = pairs.paired;
   if (c.paired < kMinPairedShare * double(s.triangles.size())) {
-    c.reason = "fewer than 90% of the triangles pair up";
+    c.reason = kReasons[2];
     return c;
   }
   const EmbreeScene triangles(s, watertight, LayoutChoice{EmbreeLayout::Triangles}),
@@ -109,7 +117,11 @@ LayoutChoice measure(const Scene& s, bool watertight, TrianglePairs& pairs) {
   trace_ns_per_ray(triangles, rays);  // warm-up: caches, lazily built parts
   trace_ns_per_ray(quads, rays);
   c.triangles_ns = c.quads_ns = std::numeric_limits<double>::infinity();
-  for (int round = 0; round < kRounds; ++round) {  // alternating, best round of each (load only adds time)
+  // Alternating, best round of each (load only adds time). Where the answer is close to the
+  // line after kRounds (a loaded machine: MPI ranks starting together), more rounds, so that a
+  // few slowed rounds do not decide it: every process of a run should get one answer.
+  for (int round = 0; round < kMaxRounds; ++round) {
+    if (round >= kRounds && std::abs(c.quads_ns / c.triangles_ns - kQuadsShareToWin) > kCloseToTheLine) break;
     const bool quads_first = round % 2 == 1;
     for (int k = 0; k < 2; ++k) {
       if ((k == 0) == quads_first) c.quads_ns = std::min(c.quads_ns, trace_ns_per_ray(quads, rays));
@@ -118,7 +130,7 @@ LayoutChoice measure(const Scene& s, bool watertight, TrianglePairs& pairs) {
   }
   const bool quads_win = c.quads_ns < kQuadsShareToWin * c.triangles_ns;
   c.layout = quads_win ? EmbreeLayout::Quads : EmbreeLayout::Triangles;
-  c.reason = quads_win ? "quads measured faster" : "quads not measured clearly faster";
+  c.reason = quads_win ? kReasons[3] : kReasons[4];
   return c;
 }
 
@@ -136,13 +148,32 @@ uint64_t fingerprint(const Scene& s, bool watertight) {
   return h;
 }
 
+std::mutex& known_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::map<uint64_t, LayoutChoice>& known_layouts() {
+  static std::map<uint64_t, LayoutChoice> known;
+  return known;
+}
+
 }  // namespace
 
+bool remember_embree_layout(const Scene& s, bool watertight, EmbreeLayout layout, double triangles_ns,
+                            double quads_ns, const std::string& reason) {
+  for (const char* r : kReasons)
+    if (reason == r) {
+      const std::lock_guard<std::mutex> lock(known_mutex());
+      known_layouts()[fingerprint(s, watertight)] = LayoutChoice{layout, 0, triangles_ns, quads_ns, r};
+      return true;
+    }
+  return false;
+}
+
 LayoutChoice choose_embree_layout(const Scene& s, bool watertight, TrianglePairs* pairs) {
-  static std::mutex mutex;
-  static std::map<uint64_t, LayoutChoice> known;
+  auto& known = known_layouts();
   const uint64_t key = fingerprint(s, watertight);
-  const std::lock_guard<std::mutex> lock(mutex);
+  const std::lock_guard<std::mutex> lock(known_mutex());
   if (auto it = known.find(key); it != known.end()) return it->second;
   TrianglePairs made;
   known[key] = measure(s, watertight, made);

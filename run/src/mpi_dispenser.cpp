@@ -19,9 +19,10 @@ constexpr int kAsk = 1, kGrant = 2, kQuit = 3;
 }
 
 struct SampleDispenser::Impl {
-  Impl(World& w, uint64_t u) : world(w), units(u) {}
+  Impl(World& w, uint64_t u, uint32_t s, uint32_t b) : world(w), units(u), spp(s), batch(b) {}
   World& world;
   uint64_t units;
+  uint32_t spp, batch;  // chunks end where a batch starts (batch_start_at_or_after)
   MPI_Comm comm = mpi_detail::chunk_comm();
   // Rank 0's counter, guarded by `m` (its own render and the server thread take from it).
   std::mutex m;
@@ -70,6 +71,7 @@ struct SampleDispenser::Impl {
     for (size_t r = 0; r < rates.size(); ++r) faster_active |= r != size_t(rank) && !finished[r] && rates[r] > mine;
     if (mine > 0 && total > 0 && count > 0 && faster_active && double(count) / mine > double(units - next) / total)
       count = 0;
+    if (count > 0) count = batch_start_at_or_after(next + count, spp, batch, units) - next;
     if (count == 0) finished[size_t(rank)] = true;
     const UnitRange s{next, count};
     next += count;
@@ -108,8 +110,9 @@ struct SampleDispenser::Impl {
   }
 };
 
-SampleDispenser::SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates)
-    : impl_(std::make_unique<Impl>(world, units)) {
+SampleDispenser::SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates, uint32_t spp,
+                                 uint32_t batch)
+    : impl_(std::make_unique<Impl>(world, units, std::max(1u, spp), batch)) {
   impl_->rates.assign(size_t(world.size()), 0.0);
   if (rates.size() == impl_->rates.size()) impl_->rates = rates;
   impl_->pending.assign(size_t(world.size()), 0);

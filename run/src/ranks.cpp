@@ -23,6 +23,24 @@ SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp) {
   return {first, base + (rank < extra ? 1u : 0u)};
 }
 
+SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp, uint32_t batch) {
+  if (batch <= 1) return share_of(rank, ranks, spp);
+  // The first ranks take the extra batches, as share_of's extra samples: rank 0, whose report
+  // describes the tracer, traces whenever there is a batch.
+  const uint32_t batches = spp / batch + (spp % batch ? 1 : 0);
+  const SampleShare b = share_of(rank, ranks, batches);
+  const uint32_t first = uint32_t(std::min<uint64_t>(uint64_t(b.first) * batch, spp));
+  const uint32_t end = uint32_t(std::min<uint64_t>(uint64_t(b.first + b.count) * batch, spp));
+  return {first, end - first};
+}
+
+uint64_t batch_start_at_or_after(uint64_t u, uint32_t spp, uint32_t batch, uint64_t units) {
+  if (batch <= 1 || u >= units) return std::min(u, units);
+  const uint64_t row = u / spp, sample = u % spp;
+  const uint64_t up = (sample + batch - 1) / batch * batch;  // the next batch's first sample
+  return std::min(up < spp ? row * spp + up : (row + 1) * spp, units);
+}
+
 std::vector<FrameBlock> blocks_of(UnitRange range, uint32_t spp, uint32_t rows) {
   if (spp == 0 || range.first > uint64_t(rows) * spp || range.count > uint64_t(rows) * spp - range.first)
     throw std::invalid_argument("blocks_of: the range leaves the frame");

@@ -60,6 +60,18 @@ int cpu_share(const std::vector<std::string>& local_devices) {
   return std::max(1, (hardware_threads() - gpus) / cpus);
 }
 
+// PATHBENCH_RANK_FILM_HASH (diagnostics, issue 30): 1 puts each CPU rank's own film hash
+// (before the reduction) in its report entry; unset, empty or 0: not. Anything else is refused.
+bool rank_film_hash_asked() {
+  const char* e = std::getenv("PATHBENCH_RANK_FILM_HASH");
+  const std::string v = e ? e : "";
+  if (v.empty() || v == "0") return false;
+  if (v == "1") return true;
+  throw InputError(fmt::format("PATHBENCH_RANK_FILM_HASH='{}': expected 1 (each CPU rank's film hash in its "
+                               "report entry) or 0",
+                               v));
+}
+
 int gpu_count() {
   return gpu_tracer().device_count();  // no context yet: the rank has not picked its GPU
 }
@@ -129,6 +141,23 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   RenderSettings s = settings;
   std::unique_ptr<RankTracer> tracer;
   int gpu_index = -1;
+  bool rank_film_hash = false;
+  on_every_rank([&] { rank_film_hash = rank_film_hash_asked(); });
+  // What a tracer measures to prepare the scene (the CPU's Embree layout under auto: a timed
+  // probe) is rank 0's on every rank (Tracer::measured): each rank probing for itself, beside
+  // the others' start, once picked another layout on one rank of three (a film differing in
+  // low bits, the same image bytes: issue 30, docs/mpi.md). CPU ranks beside GPUs trace the
+  // GPU's BVH and measure nothing.
+  const bool all_cpu = std::find(devices.begin(), devices.end(), "gpu") == devices.end();
+  std::string measured;
+  on_every_rank([&] {
+    if (all_cpu && w.root()) measured = cpu_tracer().measured(scene, s);
+  });
+  measured = w.all(measured)[0];
+  on_every_rank([&] {
+    if (all_cpu && !w.root() && !cpu_tracer().adopt_measured(scene, s, measured))
+      throw std::runtime_error(fmt::format("rank 0's measured choices cannot be read: '{}'", measured));
+  });
   on_every_rank([&] {
     // Before any other CUDA call (RankTracer's device check), so the rank's context is on its GPU.
     if (s.device == Device::Gpu) gpu_index = gpu_tracer().select_device(w.local_rank());
@@ -148,6 +177,9 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
     balance = std::all_of(devices.begin(), devices.end(), [&](const auto& d) { return d == devices[0]; })
                   ? Balance::Static : Balance::Dynamic;
   if (!w.can_dispense()) balance = Balance::Static;
+  // CPU ranks of the pixel strategy take whole batches of samples, aligned as one process's
+  // packets (kSampleBatch, ranks.h); every other rank traces each ray alone.
+  const uint32_t batch = all_cpu && s.strategy == Strategy::Pixel ? kSampleBatch : 1;
   // How the films come together: GPU ranks through NCCL where they can (gpu_reduce.h),
   // the rest through MPI. Set up (communicator, page-locked film on the GPU root) before
   // the frame's clock starts.
@@ -188,7 +220,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // Dynamic balancing only: rank 0 then serves it (its units: rows x samples). Made before
   // the frame's clock (rank 0's server thread), started after the common start.
   std::optional<SampleDispenser> dispenser;
-  if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates);
+  if (balance == Balance::Dynamic) dispenser.emplace(w, uint64_t(s.height) * s.spp, rates, s.spp, batch);
 
   // 3. The frame: from a common start to the reduced film on rank 0.
   const nlohmann::json load0 = load_sample();
@@ -224,7 +256,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
           reduce_gpu_band(gred, tracer->device_film(), film, w.rank() == gred.root, first_row, rows);
         }
       } else if (balance == Balance::Static) {
-        const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp);
+        const SampleShare share = share_of(uint32_t(w.rank()), uint32_t(w.size()), s.spp, batch);
         if (share.count) trace({0, s.height, share.first, share.count}), ++chunks;
       } else {
         double rate = rates.empty() ? 0.0 : rates[size_t(w.rank())];  // units per second in the last chunk
@@ -248,9 +280,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // PATHBENCH_RANK_FILM_HASH=1 (diagnostics, issue 30): each CPU rank's own film before the
   // reduction, hashed into its report entry, so that runs that differ say whether a rank's
   // samples or the reduction did. Costs rank 0 a pass over its film inside the frame.
-  const char* hash_env = std::getenv("PATHBENCH_RANK_FILM_HASH");
-  const std::string part_hash =
-      hash_env && std::string(hash_env) == "1" && s.device == Device::Cpu ? film_hash(film) : std::string();
+  const std::string part_hash = rank_film_hash && s.device == Device::Cpu ? film_hash(film) : std::string();
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
   const double wait_seconds = std::chrono::duration<double>(r0 - t0).count() - mine.seconds;
@@ -291,6 +321,7 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   // Where this rank's frame went: tracing (its tracer calls), waiting (chunk requests, the
   // slowest rank), and the reduction (bound check, NCCL, the download, MPI).
   if (!part_hash.empty()) entry["film_hash"] = part_hash;  // this rank's film before the reduction
+  if (mine.extra.contains("embree_layout")) entry["embree_layout"] = mine.extra["embree_layout"];  // the layout it traced
   entry["trace_seconds"] = mine.seconds;
   entry["wait_seconds"] = std::max(0.0, wait_seconds);
   entry["reduce_seconds"] = reduce_seconds;

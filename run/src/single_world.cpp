@@ -39,7 +39,7 @@ int World::end(int code) { return code; }  // no MPI: nothing to end
 struct SampleDispenser::Impl {
   uint64_t units, next = 0;
 };
-SampleDispenser::SampleDispenser(World&, uint64_t units, const std::vector<double>&) : impl_(std::make_unique<Impl>(Impl{units})) {}
+SampleDispenser::SampleDispenser(World&, uint64_t units, const std::vector<double>&, uint32_t, uint32_t) : impl_(std::make_unique<Impl>(Impl{units})) {}
 SampleDispenser::~SampleDispenser() = default;
 UnitRange SampleDispenser::next(double, uint64_t) {
   const UnitRange s{impl_->next, impl_->units - impl_->next};

@@ -27,6 +27,19 @@
 # idle_rank       3 ranks, dynamic, a frame of 16 units (8 rows x 2 spp) and chunks of at least
 #                 8 (a rank's probe): a rank is granted nothing, sends nothing (send_film_rows),
 #                 and the image is still one process's byte for byte
+# layout_agree    3 CPU ranks under --embree-layout auto: every rank traced rank 0's probed
+#                 layout, probe times and all (each rank once timed its own probe beside the
+#                 others' start: one rank of three picked triangles, a film other than one
+#                 process's with the same image bytes; issue 30), and the film is one process's
+# rank_film_hash  PATHBENCH_RANK_FILM_HASH=1: each CPU rank's own film hash in its report entry;
+#                 another value (yes) refused, exit 2, no image
+# packets        paper-cornell-ico:1 (94 triangles: above the tiny test, so Embree's packets
+#                 answer the pixel strategy's rays, and a ray at an edge by its packet mates),
+#                 40 spp over 3 ranks, static and dynamic: each rank's samples are whole
+#                 batches of 16 at batch boundaries (static: 16 + 16 + 8 a pixel, where the
+#                 plain split was 14 + 13 + 13), so its packets are one process's; the film
+#                 is one process's (the pixel strategy; the wavefront's packets follow the
+#                 threads' timing, in one process as over ranks: docs/mpi.md)
 # Small frames (64x64): each case takes a few seconds on 2 cores.
 set -u
 case_name=$1
@@ -132,6 +145,50 @@ case $case_name in
     same x.pfm
     [ "$(film_hash one.json)" = "$(film_hash x.json)" ] || fail "film_hash differs"
     grep -q '"samples": 0,' x.json || fail "no rank was idle: the case no longer tests a rank without rows" ;;
+  layout_agree)
+    frame="$base --spp 48"  # 3 batches of 16: every rank traces (run/ranks.h, kSampleBatch)
+    one
+    run -np 3 "$pb" $frame --balance static --out x.pfm --report x.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    same x.pfm
+    [ "$(film_hash one.json)" = "$(film_hash x.json)" ] || fail "film_hash differs"
+    python3 - x.json <<'EOF_PY' || fail "the ranks did not all trace rank 0's measured layout"
+import json, sys
+r = json.load(open(sys.argv[1]))
+ranks = r["ranks"]["per_rank"]
+assert len(ranks) == 3 and r["embree_layout"]["asked"] == "auto", r["embree_layout"]
+layouts = [e.get("embree_layout") for e in ranks]
+assert layouts[0] is not None and layouts[0]["probe_ns_per_ray"], layouts[0]
+for i, l in enumerate(layouts):
+    assert l == layouts[0], f"rank {i} traced {l}, rank 0 {layouts[0]}"
+print("ranks.sh layout_agree: every rank:", layouts[0]["used"], layouts[0]["probe_ns_per_ray"])
+EOF_PY
+    ;;
+  rank_film_hash)
+    export PATHBENCH_RANK_FILM_HASH=1
+    run -x PATHBENCH_RANK_FILM_HASH -np 2 "$pb" $frame --out x.pfm --report x.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
+    [ "$(grep -c '"film_hash": "fnv1a64:' x.json)" = 3 ] || fail "not a film hash for each rank and the frame"
+    export PATHBENCH_RANK_FILM_HASH=yes
+    run -x PATHBENCH_RANK_FILM_HASH -np 2 "$pb" $frame --out y.pfm
+    unset PATHBENCH_RANK_FILM_HASH
+    refused 2 "PATHBENCH_RANK_FILM_HASH='yes': expected 1" y.pfm ;;
+  packets)
+    ico="render --quiet --width 64 --height 64 --bounces 2 --spp 40 --scene paper-cornell-ico:1 --embree-layout triangles"
+    "$pb" $ico --threads 2 --out one.pfm --report one.json || fail "one-process render failed"
+    for balance in static dynamic; do
+      run -np 3 "$pb" $ico --threads 1 --balance $balance --out x.pfm --report x.json
+      [ "$status" = 0 ] || { cat err.txt >&2; fail "$balance: status $status"; }
+      if [ $balance = static ]; then
+        python3 - x.json <<'EOF_PY' || fail "static: the ranks' samples are not whole batches of 16"
+import json, sys
+spp = [e["samples_per_pixel"] for e in json.load(open(sys.argv[1]))["ranks"]["per_rank"]]
+assert spp == [16, 16, 8], spp
+EOF_PY
+      fi
+      same x.pfm
+      [ "$(film_hash one.json)" = "$(film_hash x.json)" ] || fail "$balance: film_hash differs"
+    done ;;
   mpmd_threads)
     one
     run -np 1 "$pb" $frame --balance dynamic --threads 2 --out mpmd.pfm : -np 1 "$pb" $frame --balance dynamic --threads 1 --out mpmd.pfm

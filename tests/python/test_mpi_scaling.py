@@ -41,7 +41,8 @@ FAKE_PATHBENCH = textwrap.dedent("""\
            "fingerprint": {{"cpu_model": "fake cpu", "num_cpus": 2}}}}
     if ranks > 1:
         rep["ranks"] = {{"frame_seconds": 0.011 / ranks, "reduce_seconds": 0.0001, "load_balance": 1.0,
-                        "parallel_efficiency": 0.9, "reduction": {{"gpu_ranks": "mpi"}}, "per_rank": []}}
+                        "parallel_efficiency": 0.9, "reduction": {{"gpu_ranks": "mpi"}},
+                        "per_rank": [{{"rank": k, "embree_layout": {{"used": "quads"}}}} for k in range(ranks)]}}
     json.dump(rep, open(get("--report"), "w"))
     """)
 
@@ -119,6 +120,7 @@ def test_any_repetition_that_differs_is_reported(fakes, tmp_path, run_no, kind, 
     assert f"NOT IDENTICAL: strong-cpu 64x64x32 on 2 ranks: {why}" in r.stdout
     assert strong(doc, 1)["identical"] is True
     assert len(two["film_hash_all"]) == 3 and two["base_film_hash"] == "fnv1a64:0000000000000001"
+    assert two["rank_layouts_all"] == [["quads", "quads"]] * 3  # the layout each rank traced, each repetition
     assert (two["film_hash_all"][int(run_no) - 4] != two["base_film_hash"]) == (kind != "file")
 
 

@@ -153,5 +153,23 @@ TEST(EmbreeLayouts, AutoFollowsItsProbeAndIsRemembered) {
   EXPECT_EQ(c.triangles_ns, 0.0) << "not measured: " << c.reason;
 }
 
+// An MPI rank takes rank 0's probed answer (run/ranks_render.cpp, issue 30): remembered, it
+// is what every later choice and Auto scene of the process gets, the probe's times and all.
+TEST(EmbreeLayouts, RememberedAnswerIsTheProcesssAnswer) {
+  Scene s = make_paper_cornell();
+  s.positions[0].x += 1e-3f;  // a scene of its own (no other test has remembered it)
+  s.finalize();
+  ASSERT_TRUE(cpu::remember_embree_layout(s, true, EmbreeLayout::Triangles, 80.5, 79.25,
+                                          "quads not measured clearly faster"));
+  const cpu::LayoutChoice c = cpu::choose_embree_layout(s, true);
+  EXPECT_EQ(c.layout, EmbreeLayout::Triangles);
+  EXPECT_EQ(c.triangles_ns, 80.5);
+  EXPECT_EQ(c.quads_ns, 79.25);
+  EXPECT_STREQ(c.reason, "quads not measured clearly faster");
+  EXPECT_EQ(cpu::make_embree_scene(s, true)->layout(), EmbreeLayout::Triangles);
+  EXPECT_FALSE(cpu::remember_embree_layout(s, true, EmbreeLayout::Quads, 1, 1, "a reason the probe never gives"));
+  EXPECT_EQ(cpu::choose_embree_layout(s, true).layout, EmbreeLayout::Triangles) << "a refused answer is not kept";
+}
+
 }  // namespace
 }  // namespace pb

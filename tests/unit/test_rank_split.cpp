@@ -3,6 +3,7 @@
 // on), and the rank render's grant rule and report arithmetic.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,59 @@ void expect_chunks_equal_whole(const RenderSettings& whole, const std::vector<ui
   EXPECT_EQ(paths, one.report.paths);
   EXPECT_EQ(sum.counts(), one.film.counts());
   EXPECT_EQ(sum.raw_sums(), one.film.raw_sums());  // bit for bit
+}
+
+// Issue 30: CPU ranks of the pixel strategy trace whole batches of kSampleBatch samples at
+// absolute batch boundaries, static and dynamic, so that every packet of theirs (W = 16 or 8
+// samples of a pixel from the block's first) holds the samples one process's does: Embree's
+// packet answer for a ray at an edge depends on its mates. Before, 3 ranks at 800 spp took
+// 267 + 267 + 266 samples, and a rank's packets started at sample 267.
+TEST(RankSplit, CpuSharesAndChunksAreWholeAlignedBatches) {
+  const uint32_t b = run::kSampleBatch;
+  ASSERT_EQ(b % 16, 0u) << "a batch must hold whole packets of the widest ISA (AVX-512: 16)";
+  auto aligned = [&](uint32_t sample, uint32_t spp) { return sample % b == 0 || sample == spp; };
+  std::vector<uint32_t> spps;
+  for (uint32_t spp = 1; spp <= 100; ++spp) spps.push_back(spp);
+  for (uint32_t spp : {255u, 256u, 267u, 800u, 801u, 1024u}) spps.push_back(spp);
+  for (uint32_t spp : spps)
+    for (uint32_t ranks = 1; ranks <= 6; ++ranks) {
+      uint32_t next = 0, most = 0;
+      for (uint32_t r = 0; r < ranks; ++r) {
+        const run::SampleShare sh = run::share_of(r, ranks, spp, b);
+        EXPECT_EQ(sh.first, next) << spp << " spp, rank " << r << " of " << ranks;
+        EXPECT_TRUE(aligned(sh.first, spp) && aligned(sh.first + sh.count, spp))
+            << spp << " spp, rank " << r << " of " << ranks << ": samples " << sh.first << " + " << sh.count;
+        next = sh.first + sh.count;
+        most = std::max(most, sh.count);
+        const run::SampleShare one = run::share_of(r, ranks, spp, 1);  // batch 1: the plain split
+        const run::SampleShare plain = run::share_of(r, ranks, spp);
+        EXPECT_TRUE(one.first == plain.first && one.count == plain.count);
+      }
+      EXPECT_EQ(next, spp) << spp << " spp over " << ranks << " ranks: every sample once";
+      const uint32_t batches = (spp + b - 1) / b;
+      EXPECT_EQ(most, std::min(spp, (batches + ranks - 1) / ranks * b)) << spp << " spp, " << ranks << " ranks";
+      EXPECT_EQ(run::share_of(0, ranks, spp, b).count, most) << "rank 0 traces whenever there is a batch";
+    }
+  EXPECT_EQ(run::share_of(1, 3, 800, b).first, 272u);  // 17 + 17 + 16 batches
+  EXPECT_EQ(run::share_of(2, 3, 800, b).count, 256u);
+  // Dynamic chunks end where a batch starts: every block of every chunk is then aligned.
+  const uint32_t rows = 5;
+  for (uint32_t spp : {1u, 15u, 16u, 17u, 40u, 800u}) {
+    const uint64_t units = uint64_t(rows) * spp;
+    uint64_t at = 0;
+    for (uint64_t want = 1; at < units; want = want * 3 + 1) {  // chunks of growing, uneven sizes
+      const uint64_t end = run::batch_start_at_or_after(at + want, spp, b, units);
+      ASSERT_GT(end, at);
+      for (uint64_t u = at + want; u < end; ++u) EXPECT_NE((u % spp) % b, 0u) << "a batch start was skipped";
+      for (const run::FrameBlock& blk : run::blocks_of({at, end - at}, spp, rows))
+        EXPECT_TRUE(aligned(blk.first_sample, spp) && aligned(blk.first_sample + blk.samples, spp))
+            << spp << " spp: block of row " << blk.first_row << " samples " << blk.first_sample << " + " << blk.samples;
+      at = end;
+    }
+    EXPECT_EQ(at, units);
+    EXPECT_EQ(run::batch_start_at_or_after(units + 3, spp, b, units), units);
+    EXPECT_EQ(run::batch_start_at_or_after(7, spp, 1, units), std::min<uint64_t>(7, units));  // batch 1: as asked
+  }
 }
 
 TEST(RankSplit, BlocksOfAUnitRange) {

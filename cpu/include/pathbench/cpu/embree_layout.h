@@ -9,6 +9,7 @@
 // wavefront, say) traces the same layout. Pin the layout (--embree-layout) where runs in
 // different processes must trace alike.
 #include <cstddef>
+#include <string>
 
 #include "pathbench/common/scene.h"
 #include "pathbench/common/settings.h"
@@ -30,5 +31,13 @@ struct LayoutChoice {
 // `pairs`, where given, receives the pairing the probe made (left empty when the answer
 // was remembered or no probe ran), so that the caller need not pair again.
 LayoutChoice choose_embree_layout(const Scene& scene, bool watertight, TrianglePairs* pairs = nullptr);
+
+// Makes `choice` this process's answer for `scene` from now on, as if its probe had given
+// it (choose_embree_layout then returns it, without pairs). MPI ranks: every rank takes
+// rank 0's answer (run/ranks_render.cpp), since the probe is timed and a rank probing beside
+// the others' builds could pick another layout, whose films differ in low bits (issue 30).
+// Returns false (nothing remembered) where `reason` is not one the probe gives.
+bool remember_embree_layout(const Scene& scene, bool watertight, EmbreeLayout layout, double triangles_ns,
+                            double quads_ns, const std::string& reason);
 
 }  // namespace pb::cpu

@@ -20,6 +20,24 @@ struct SampleShare {
 // sample more. Throws std::invalid_argument for rank >= ranks or ranks == 0.
 SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp);
 
+// Whole batches: the CPU's pixel strategy traces a pixel's samples in packets of up to 16 (8
+// with AVX2) from its block's first sample, and Embree's packet query answers a ray at an
+// edge by its packet mates (issue 30: TinyIsa.AnswersDoNotDependOnPacketMates; the tiny test
+// answers per ray, Embree's packets above its limit do not). CPU ranks therefore take samples
+// in batches of kSampleBatch aligned to absolute sample indices (the last batch of a pixel
+// short where spp is not a multiple), so each packet holds the samples one process's does,
+// whatever the rank count or the chunks. (GPU ranks, and CPU ranks beside them, trace each
+// ray alone: batch 1.)
+constexpr uint32_t kSampleBatch = 16;
+// share_of over whole batches of `batch` samples: [first, first + count) starts at a
+// multiple of `batch` and ends at one or at spp; the first ranks get a batch more (the
+// largest share is ceil(batches / ranks) batches), and the last ranks get nothing where there
+// are fewer batches than ranks. batch 1: share_of.
+SampleShare share_of(uint32_t rank, uint32_t ranks, uint32_t spp, uint32_t batch);
+// The first unit at or after `u` (row-major rows x spp, UnitRange) where a batch of
+// `batch` samples starts (sample % batch == 0); `units` (rows x spp) where none is left.
+uint64_t batch_start_at_or_after(uint64_t u, uint32_t spp, uint32_t batch, uint64_t units);
+
 // A block of the frame a tracer call traces: samples [first_sample, first_sample +
 // samples) of every pixel of rows [first_row, first_row + rows).
 struct FrameBlock {

@@ -91,6 +91,14 @@ class Tracer {
   virtual std::unique_ptr<PreparedScene> prepare_bvh(const Scene&, const bvh::GpuBvhOptions&) const {
     throw std::logic_error("prepare_bvh: only the GPU tracer takes a BVH layout");
   }
+  // What this process measured to prepare `scene` with `settings` (the CPU's Embree layout
+  // under --embree-layout auto: a timed probe), as one line of text; empty where nothing is
+  // measured. MPI ranks all adopt rank 0's (adopt_measured), so every rank traces the layout
+  // one process would and no rank's probe, timed beside the other ranks' start, picks
+  // another (its samples would differ in low bits: issue 30). adopt_measured returns false
+  // for a line it cannot read.
+  virtual std::string measured(const Scene&, const RenderSettings&) const { return {}; }
+  virtual bool adopt_measured(const Scene&, const RenderSettings&, const std::string&) const { return true; }
   // A film on the device for PreparedScene::render's `keep`; null where the tracer keeps none (CPU).
   virtual std::unique_ptr<DeviceFilm> make_device_film() const { return nullptr; }
   // The device's part of the machine fingerprint; null for the CPU (run_context.cpp adds Embree's and TBB's).

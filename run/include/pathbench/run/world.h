@@ -110,7 +110,10 @@ class SampleDispenser {
   // then the first grants are probes. A rank whose chunk would outlast the frame's
   // projected end (what is left / the ranks' total rate) gets none, unless it is the
   // fastest: a slow rank never holds the frame up.
-  SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates = {});
+  // `spp` and `batch`: every chunk starts and ends where a batch of `batch` samples starts
+  // (batch_start_at_or_after, ranks.h: kSampleBatch for CPU ranks), or at the frame's end.
+  SampleDispenser(World& world, uint64_t units, const std::vector<double>& rates = {}, uint32_t spp = 1,
+                  uint32_t batch = 1);
   ~SampleDispenser();
   SampleDispenser(const SampleDispenser&) = delete;
   SampleDispenser& operator=(const SampleDispenser&) = delete;
