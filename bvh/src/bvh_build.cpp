@@ -6,8 +6,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
+#include <string_view>
+#include <type_traits>
+
+#include "pathbench/common/errors.h"
 
 namespace pb::bvh {
 
@@ -176,6 +181,30 @@ void on_embree_error(void*, RTCError code, const char* str) {
 }
 
 }  // namespace
+
+BvhBuildOptions BvhBuildOptions::with_env() const {
+  BvhBuildOptions o = *this;
+  const auto number = [](const char* name, double lo, double hi, auto& value) {  // an integer where value is one
+    const char* v = std::getenv(name);
+    if (!v || !*v) return;
+    char* end = nullptr;
+    const double x = std::strtod(v, &end);
+    const bool integral = std::is_integral_v<std::remove_reference_t<decltype(value)>>;
+    if (end == v || *end != '\0' || !(x >= lo && x <= hi) || (integral && x != std::floor(x)))
+      throw InputError(fmt::format("{}: '{}' is not a number in [{}, {}]", name, v, lo, hi));
+    value = static_cast<std::remove_reference_t<decltype(value)>>(x);
+  };
+  number("PATHBENCH_GPU_BVH_LEAF_SIZE", 1, kMaxLeafPrims, o.max_leaf_size);
+  number("PATHBENCH_GPU_BVH_TRAVERSAL_COST", 1e-3, 1e3, o.traversal_cost);
+  number("PATHBENCH_GPU_BVH_INTERSECTION_COST", 1e-3, 1e3, o.intersection_cost);
+  if (const char* v = std::getenv("PATHBENCH_GPU_BVH_QUALITY"); v && *v) {
+    const std::string_view q(v);
+    if (q != "medium" && q != "high")
+      throw InputError(fmt::format("PATHBENCH_GPU_BVH_QUALITY: '{}' is not medium or high", q));
+    o.high_quality = q == "high";
+  }
+  return o;
+}
 
 BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options) {
   if (options.max_leaf_size < 1 || options.max_leaf_size > kMaxLeafPrims)
