@@ -108,7 +108,7 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
                                    "every ray and takes at most {} (binary suits it)", scene.name,
                                    scene.triangles.size(), kLeavesMaxTriangles));
     const bool wide = out.layout == GpuBvhLayout::Wide4 || out.layout == GpuBvhLayout::Wide8;
-    BvhBuildOptions bo;
+    BvhBuildOptions bo = BvhBuildOptions{}.with_env();  // the environment's build overrides (measurements)
     if (wide) bo.max_leaf_size = kWideMaxLeafTris;  // a wide leaf holds up to 3
     out.binary = build_bvh(scene, bo);
     out.binary_depth = out.binary.depth;

@@ -16,6 +16,11 @@ struct BvhBuildOptions {
   float traversal_cost = 1.0f;    // SAH cost of visiting a node, relative to...
   float intersection_cost = 1.0f; // ...testing one triangle
   bool high_quality = false;      // Embree's HIGH quality (spatial splits)
+  // These options with the environment's overrides, for measuring builds without
+  // rebuilding: PATHBENCH_GPU_BVH_LEAF_SIZE=1..16, PATHBENCH_GPU_BVH_QUALITY=medium|high,
+  // PATHBENCH_GPU_BVH_TRAVERSAL_COST=<x>, PATHBENCH_GPU_BVH_INTERSECTION_COST=<x> (x > 0).
+  // Throws InputError naming the variable for a value it cannot use.
+  BvhBuildOptions with_env() const;
 };
 
 struct BvhHost {
