@@ -241,8 +241,8 @@ BvhView SceneBvhHost::view() const {
       v.kind = TraversalKind::Leaves;
       v.leaves = {leaves.data(), binary.tris.data(), uint32_t(leaves.size()), uint32_t(binary.tris.size())};
       break;
-    case GpuBvhLayout::Rects:  // the leaves layout's kernels, tracing the rectangles
-      v.kind = TraversalKind::Leaves;
+    case GpuBvhLayout::Rects:  // kernels of their own (TraversalKind::Rects)
+      v.kind = TraversalKind::Rects;
       v.leaves.rects = rects.data();
       v.leaves.rect_groups = rect_groups;
       break;

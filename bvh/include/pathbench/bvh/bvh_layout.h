@@ -6,8 +6,8 @@
 //   leaves  the binary BVH's leaves, each with its box, and no inner nodes
 //           (leaf_list.h), for tiny scenes without instances;
 //   rects   the scene as axis-aligned rectangles (axis_plane.h: every triangle half of
-//           one), each tested as a flat box, no triangle test; traced by the leaves
-//           layout's kernels (TraversalKind::Leaves with LeafListView::rects);
+//           one), each tested as a flat box, no triangle test (TraversalKind::Rects,
+//           its arrays in LeafListView::rects);
 //   auto    brute at most `brute_max_triangles` triangles, else leaves up to
 //           kLeavesAutoMaxTriangles (a scene without instances) -- rects where every
 //           triangle pairs into an axis-aligned rectangle --, else kAutoLayout;

@@ -35,8 +35,8 @@ struct LeafListView {
   uint32_t num_leaves;
   uint32_t num_tris;
   uint32_t exact_ties = 0;  // as BinaryBvhView's
-  // GpuBvhLayout::Rects (axis_plane.h): the scene as axis-aligned rectangles, traced in
-  // place of the leaves (no boxes, no triangle tests) where set.
+  // GpuBvhLayout::Rects (axis_plane.h, TraversalKind::Rects): the scene as axis-aligned
+  // rectangles, traced instead of the leaves (no boxes, no triangle tests).
   const AxisRect* rects = nullptr;
   RectGroups rect_groups{};
 };
@@ -75,7 +75,6 @@ PB_HD bool enters_leaf(const LeafBox* leaves, uint32_t i, const SlabRay& sr, flo
 template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
 PB_HD uint32_t traverse_leaves(const LeafListView& f, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                              TraversalStats* stats = nullptr) {
-  if (f.rects != nullptr) return traverse_rects<kAnyHit>(f.rects, f.rect_groups, o, d, t_max, t_hit, stats);
   const bool exact = kExact < 0 ? f.exact_ties != 0 : kExact == 1;
   const WatertightRay wr = make_watertight_ray(o, d);
   const detail::SlabRay sr = detail::make_slab_ray(o, d);
