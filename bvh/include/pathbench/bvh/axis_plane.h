@@ -31,6 +31,7 @@
 // (one edge function of the hit point; a point exactly on it takes the lower id).
 // ray_t_min's least t, bit for bit (min |inv| is 1 / max |d|). Host+device.
 #include <cstdint>
+#include <cstring>
 
 #include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/hd.h"
@@ -61,21 +62,30 @@ namespace detail {
 
 PB_HD float plane_t(float a, float o, float inv) { return (a - o) * inv; }
 
-PB_HD void load_rect(const AxisRect* rects, uint32_t i, float (&lo)[3], float (&hi)[3], uint32_t& key,
-                     uint32_t& other) {
+// A 32-byte box record (AxisRect here, leaf_list.h's LeafBox): lo[3], a word, hi[3], a word;
+// on the device two 16-byte loads.
+template <class Box>
+PB_HD void load_box_record(const Box* boxes, uint32_t i, float (&lo)[3], float (&hi)[3], uint32_t& w3, uint32_t& w7) {
+  static_assert(sizeof(Box) == 32 && alignof(Box) == 16, "two 16-byte loads");
 #if defined(__CUDA_ARCH__)
-  const float4* p = reinterpret_cast<const float4*>(rects + i);
+  const float4* p = reinterpret_cast<const float4*>(boxes + i);
   const float4 a = __ldg(p), b = __ldg(p + 1);
   lo[0] = a.x; lo[1] = a.y; lo[2] = a.z;
-  key = __float_as_uint(a.w);
+  w3 = __float_as_uint(a.w);
   hi[0] = b.x; hi[1] = b.y; hi[2] = b.z;
-  other = __float_as_uint(b.w);
+  w7 = __float_as_uint(b.w);
 #else
-  const AxisRect& r = rects[i];
-  for (int k = 0; k < 3; ++k) { lo[k] = r.lo[k]; hi[k] = r.hi[k]; }
-  key = r.key;
-  other = r.other;
+  const unsigned char* p = reinterpret_cast<const unsigned char*>(boxes + i);
+  std::memcpy(lo, p, 12);
+  std::memcpy(&w3, p + 12, 4);
+  std::memcpy(hi, p + 16, 12);
+  std::memcpy(&w7, p + 28, 4);
 #endif
+}
+
+PB_HD void load_rect(const AxisRect* rects, uint32_t i, float (&lo)[3], float (&hi)[3], uint32_t& key,
+                     uint32_t& other) {
+  load_box_record(rects, i, lo, hi, key, other);
 }
 
 // Which side of the rectangle's diagonal the in-plane point (pu, pv) lies on (u = k + 1,

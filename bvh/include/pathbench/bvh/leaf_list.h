@@ -47,17 +47,8 @@ constexpr uint32_t kLeafGroup = 32;
 namespace detail {
 
 PB_HD void load_leaf(const LeafBox* leaves, uint32_t i, float (&lo)[3], float (&hi)[3], uint32_t& ref) {
-#if defined(__CUDA_ARCH__)
-  const float4* p = reinterpret_cast<const float4*>(leaves + i);
-  const float4 a = __ldg(p), b = __ldg(p + 1);
-  lo[0] = a.x; lo[1] = a.y; lo[2] = a.z;
-  ref = __float_as_uint(a.w);
-  hi[0] = b.x; hi[1] = b.y; hi[2] = b.z;
-#else
-  const LeafBox& l = leaves[i];
-  for (int k = 0; k < 3; ++k) { lo[k] = l.lo[k]; hi[k] = l.hi[k]; }
-  ref = l.ref;
-#endif
+  uint32_t pad;
+  load_box_record(leaves, i, lo, hi, ref, pad);
 }
 
 // Leaf i's box entered before t (slab_interval, as a binary node's child); its ref.
