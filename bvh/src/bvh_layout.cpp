@@ -191,6 +191,11 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
     if (out.rects.empty() && !build_axis_rects(scene, out.rects, out.rect_groups, &why))
       throw InputError(fmt::format("GPU BVH layout rects: scene '{}': {} (leaves or binary suit it)", scene.name, why));
     out.layout = GpuBvhLayout::Rects;
+    // The leaves layout too (a few boxes and the triangles): what --no-watertight's triangle
+    // test (Moeller-Trumbore, the accuracy study's) traces, as the rectangles are a watertight test.
+    out.binary = build_bvh(scene, BvhBuildOptions{});
+    out.leaves = leaf_boxes(out.binary);
+    out.binary.nodes.clear();
   } else {
     if (out.layout == GpuBvhLayout::Leaves && !scene.instances.empty())
       throw InputError(fmt::format("GPU BVH layout leaves: scene '{}' has instances, whose ties the leaves traversal does "
@@ -241,8 +246,9 @@ BvhView SceneBvhHost::view() const {
       v.kind = TraversalKind::Leaves;
       v.leaves = {leaves.data(), binary.tris.data(), uint32_t(leaves.size()), uint32_t(binary.tris.size())};
       break;
-    case GpuBvhLayout::Rects:  // kernels of their own (TraversalKind::Rects)
+    case GpuBvhLayout::Rects:  // kernels of their own (TraversalKind::Rects); the leaves for Moeller-Trumbore
       v.kind = TraversalKind::Rects;
+      v.leaves = {leaves.data(), binary.tris.data(), uint32_t(leaves.size()), uint32_t(binary.tris.size())};
       v.leaves.rects = rects.data();
       v.leaves.rect_groups = rect_groups;
       break;

@@ -30,7 +30,8 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.wide_nodes.assign(bvh.wide.nodes, "BVH nodes", lower);
   m.leaf_boxes.assign(bvh.leaves, "BVH nodes", lower);
   m.rects.assign(bvh.rects, "BVH nodes", lower);
-  const bool binary_tris = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::Leaves;
+  const bool binary_tris = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::Leaves ||
+                           bvh.layout == GpuBvhLayout::Rects;  // rects: its leaves, for Moeller-Trumbore
   m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : binary_tris ? bvh.binary.tris : bvh.wide.tris,
                 "BVH triangles", lower);
   const TwoLevelHost& two = bvh.two_level;

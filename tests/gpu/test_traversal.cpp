@@ -404,6 +404,29 @@ TEST(RectsLayout, CornersAndEdgesOfTheBoxAreClosed) {
   }
 }
 
+// --no-watertight (Moeller-Trumbore, the accuracy study's triangle test) on a rects scene
+// traces the leaves the layout keeps: the leaves layout's answers, not the rectangles'.
+TEST(RectsLayout, MoellerTrumboreTracesTheLeaves) {
+  const Scene box = load_scene("paper-cornell");
+  GpuBvhOptions o;
+  o.layout = GpuBvhLayout::Leaves;
+  const SceneBvhHost rects = build_scene_bvh(box, GpuBvhOptions{}), leaves = build_scene_bvh(box, o);
+  ASSERT_EQ(rects.layout, GpuBvhLayout::Rects);
+  const Vec3f ext = box.bounds_max - box.bounds_min;
+  const auto rays = test::random_rays(box.bounds_min + ext * 0.02f, box.bounds_max - ext * 0.02f, 5000, 29);
+  size_t differ = 0;
+  for (const Ray3& r : rays) {
+    float ta = 0, tb = 0;
+    const uint32_t a = traverse<false, false>(rects.view(), r.o, r.d, r.t_max, ta);
+    const uint32_t b = traverse<false, false>(leaves.view(), r.o, r.d, r.t_max, tb);
+    float tc = 0, td = 0;
+    const uint32_t c = traverse<false, false, int(TraversalKind::Rects)>(rects.view(), r.o, r.d, r.t_max, tc);
+    const uint32_t d = traverse<false, false, int(TraversalKind::Leaves)>(leaves.view(), r.o, r.d, r.t_max, td);
+    differ += a != b || ta != tb || c != d || tc != td || a != c || ta != tc;
+  }
+  EXPECT_EQ(differ, 0u);
+}
+
 // A square split into four triangles around its centre: rays exactly through the shared
 // centre vertex and through points of the shared diagonals hit at least one triangle.
 TEST(Watertight, SharedEdgesAndVertexOfAFan) {

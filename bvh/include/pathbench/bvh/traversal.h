@@ -61,8 +61,10 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
     return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::Leaves)) {
     return traverse_leaves<kAnyHit, kWatertight, 0>(bvh.leaves, o, d, t_max, t_hit, stats);  // no instances: no ties rule
-  } else if constexpr (kKind == int(TraversalKind::Rects)) {
+  } else if constexpr (kKind == int(TraversalKind::Rects) && kWatertight) {
     return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::Rects)) {  // Moeller-Trumbore asked for: the leaves it keeps
+    return traverse_leaves<kAnyHit, false, 0>(bvh.leaves, o, d, t_max, t_hit, stats);
   } else {
     switch (bvh.kind) {
       case TraversalKind::Wide: return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
@@ -71,8 +73,9 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       case TraversalKind::AllTriangles:
         return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
       case TraversalKind::Leaves: return traverse_leaves<kAnyHit, kWatertight>(bvh.leaves, o, d, t_max, t_hit, stats);
-      case TraversalKind::Rects:
-        return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
+      case TraversalKind::Rects:  // a triangle test (Moeller-Trumbore) asked for: the leaves the layout keeps
+        if constexpr (!kWatertight) return traverse_leaves<kAnyHit, false>(bvh.leaves, o, d, t_max, t_hit, stats);
+        else return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
       default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
     }
   }
