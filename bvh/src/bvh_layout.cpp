@@ -265,6 +265,7 @@ uint64_t SceneBvhHost::bytes() const {
          rects.size() * sizeof(AxisRect) + two_level.bytes();
 }
 uint32_t SceneBvhHost::nodes() const {
+  if (layout == GpuBvhLayout::Rects) return uint32_t(rects.size());  // its leaves serve Moeller-Trumbore only
   return uint32_t(binary.nodes.size() + wide.nodes.size() + leaves.size() + rects.size() + two_level.top_nodes.size() +
                   two_level.bottom_nodes.size());
 }

@@ -332,6 +332,7 @@ TEST(RectsLayout, AutoPicksRectsWhereEveryTriangleIsHalfARectangle) {
   EXPECT_EQ(build_scene_bvh(box, GpuBvhOptions{}).layout, GpuBvhLayout::Rects);
   const SceneBvhHost r = build_scene_bvh(box, GpuBvhOptions{});
   EXPECT_EQ(r.rects.size(), 7u);
+  EXPECT_EQ(r.nodes(), 7u);
   EXPECT_EQ(r.view().kind, TraversalKind::Rects);
   const Scene ico = load_scene("paper-cornell-ico:0");
   EXPECT_EQ(build_scene_bvh(ico, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);  // 34 triangles: past the leaves' 32
