@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cstdlib>
@@ -17,7 +18,8 @@ constexpr struct {
   GpuBvhLayout layout;
   const char* name;
 } kNames[] = {{GpuBvhLayout::Auto, "auto"},   {GpuBvhLayout::Binary, "binary"}, {GpuBvhLayout::Wide4, "wide4"},
-              {GpuBvhLayout::Wide8, "wide8"}, {GpuBvhLayout::Brute, "brute"},   {GpuBvhLayout::Leaves, "leaves"}};
+              {GpuBvhLayout::Wide8, "wide8"}, {GpuBvhLayout::Brute, "brute"},   {GpuBvhLayout::Leaves, "leaves"},
+              {GpuBvhLayout::Rects, "rects"}};
 
 // The binary BVH's leaves in depth-first order, each with the box its parent node holds
 // for it (padded by the builder), for the leaves layout.
@@ -44,7 +46,85 @@ std::vector<LeafBox> leaf_boxes(const BvhHost& bvh) {
   }
   return out;
 }
+// Triangles i and j as one axis-aligned rectangle (build_axis_rects): false where they are not.
+bool make_axis_rect(const Scene& scene, uint32_t i, uint32_t j, AxisRect& r, int& axis) {
+  Vec3f p[2][3];
+  for (int t = 0; t < 2; ++t)
+    for (int c = 0; c < 3; ++c) p[t][c] = scene.positions[scene.triangles[t == 0 ? i : j].v[c]];
+  for (int k = 0; k < 3; ++k) {
+    const float c = p[0][0][k];
+    bool flat = true;
+    for (const auto& tri : p)
+      for (const Vec3f& v : tri) flat = flat && v[k] == c;
+    if (!flat) continue;
+    const int u = k == 2 ? 0 : k + 1, v = u == 2 ? 0 : u + 1;
+    float u0 = p[0][0][u], u1 = u0, v0 = p[0][0][v], v1 = v0;
+    for (const auto& tri : p)
+      for (const Vec3f& q : tri) {
+        u0 = std::min(u0, q[u]); u1 = std::max(u1, q[u]);
+        v0 = std::min(v0, q[v]); v1 = std::max(v1, q[v]);
+      }
+    if (!(u0 < u1 && v0 < v1)) return false;
+    // Corner index of each vertex (bit 0: u1, bit 1: v1), or not a corner.
+    int corner[2][3];
+    for (int t = 0; t < 2; ++t)
+      for (int c = 0; c < 3; ++c) {
+        const Vec3f& q = p[t][c];
+        if ((q[u] != u0 && q[u] != u1) || (q[v] != v0 && q[v] != v1)) return false;
+        corner[t][c] = (q[u] == u1 ? 1 : 0) | (q[v] == v1 ? 2 : 0);
+      }
+    int mask[2] = {0, 0};
+    for (int t = 0; t < 2; ++t)
+      for (int c = 0; c < 3; ++c) mask[t] |= 1 << corner[t][c];
+    // Each half three distinct corners, together all four, sharing a diagonal: corners
+    // {0, 3} (u0v0-u1v1) or {1, 2} (u0v1-u1v0).
+    if (__builtin_popcount(mask[0]) != 3 || __builtin_popcount(mask[1]) != 3 || (mask[0] | mask[1]) != 15) return false;
+    const int shared = mask[0] & mask[1];
+    if (shared != 0b1001 && shared != 0b0110) return false;
+    const bool anti = shared == 0b0110;
+    const int third_lower = __builtin_ctz(mask[0] & ~shared);  // triangle i is the lower id
+    const float pu = third_lower & 1 ? u1 : u0, pv = third_lower & 2 ? v1 : v0;
+    const bool lower_on_plus = detail::rect_side(u0, u1, v0, v1, anti, pu, pv) > 0.0f;
+    r = AxisRect{};
+    r.lo[k] = r.hi[k] = c;
+    r.lo[u] = u0; r.hi[u] = u1;
+    r.lo[v] = v0; r.hi[v] = v1;
+    r.key = i;
+    r.other = j | (anti ? kRectAntiDiagonal : 0u) | (lower_on_plus ? kRectLowerOnPlus : 0u);
+    axis = k;
+    return true;
+  }
+  return false;
+}
 }  // namespace
+
+bool build_axis_rects(const Scene& scene, std::vector<AxisRect>& rects, RectGroups& groups, std::string* why) {
+  const size_t n = scene.triangles.size();
+  std::vector<AxisRect> by_axis[3];
+  std::vector<char> paired(n, 0);
+  for (uint32_t i = 0; i < n; ++i) {
+    if (paired[i]) continue;
+    bool found = false;
+    for (uint32_t j = i + 1; j < n && !found; ++j) {
+      AxisRect r;
+      int axis;
+      if (paired[j] || !make_axis_rect(scene, i, j, r, axis)) continue;
+      paired[i] = paired[j] = 1;
+      by_axis[axis].push_back(r);  // i ascending: each group in lower-id order
+      found = true;
+    }
+    if (!found) {
+      if (why) *why = fmt::format("triangle {} is not half of an axis-aligned rectangle", i);
+      return false;
+    }
+  }
+  rects.clear();
+  for (int k = 0; k < 3; ++k) {
+    rects.insert(rects.end(), by_axis[k].begin(), by_axis[k].end());
+    groups.end[k] = uint32_t(rects.size());
+  }
+  return n > 0;
+}
 
 const char* to_string(GpuBvhLayout l) {
   if (l == GpuBvhLayout::TwoLevel) return "two-level";  // chosen by --instancing, not by name
@@ -56,7 +136,7 @@ const char* to_string(GpuBvhLayout l) {
 GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what) {
   for (const auto& n : kNames)
     if (name == n.name) return n.layout;
-  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute, leaves)", what, name));
+  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute, leaves, rects)", what, name));
 }
 
 GpuBvhOptions GpuBvhOptions::from_env(Instancing instancing) {
@@ -99,6 +179,23 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
       bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
       bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
     }
+  } else if (out.layout == GpuBvhLayout::Rects ||
+             (out.layout == GpuBvhLayout::Leaves && options.layout == GpuBvhLayout::Auto &&
+              build_axis_rects(scene, out.rects, out.rect_groups))) {
+    // auto: a scene of axis-aligned rectangles (paper-cornell) is traced as rectangles.
+    std::string why;
+    if (!scene.instances.empty())
+      throw InputError(fmt::format("GPU BVH layout rects: scene '{}' has instances, whose ties the rectangles' traversal "
+                                   "does not order as the other layouts do (binary, wide4, wide8, brute or --instancing do)",
+                                   scene.name));
+    if (out.rects.empty() && !build_axis_rects(scene, out.rects, out.rect_groups, &why))
+      throw InputError(fmt::format("GPU BVH layout rects: scene '{}': {} (leaves or binary suit it)", scene.name, why));
+    out.layout = GpuBvhLayout::Rects;
+    // The leaves layout too (a few boxes and the triangles): what --no-watertight's triangle
+    // test (Moeller-Trumbore, the accuracy study's) traces, as the rectangles are a watertight test.
+    out.binary = build_bvh(scene, BvhBuildOptions{});
+    out.leaves = leaf_boxes(out.binary);
+    out.binary.nodes.clear();
   } else {
     if (out.layout == GpuBvhLayout::Leaves && !scene.instances.empty())
       throw InputError(fmt::format("GPU BVH layout leaves: scene '{}' has instances, whose ties the leaves traversal does "
@@ -149,6 +246,12 @@ BvhView SceneBvhHost::view() const {
       v.kind = TraversalKind::Leaves;
       v.leaves = {leaves.data(), binary.tris.data(), uint32_t(leaves.size()), uint32_t(binary.tris.size())};
       break;
+    case GpuBvhLayout::Rects:  // kernels of their own (TraversalKind::Rects); the leaves for Moeller-Trumbore
+      v.kind = TraversalKind::Rects;
+      v.leaves = {leaves.data(), binary.tris.data(), uint32_t(leaves.size()), uint32_t(binary.tris.size())};
+      v.leaves.rects = rects.data();
+      v.leaves.rect_groups = rect_groups;
+      break;
     default:
       v.kind = TraversalKind::Binary;
       v.binary = binary.view();
@@ -159,15 +262,17 @@ BvhView SceneBvhHost::view() const {
 
 uint64_t SceneBvhHost::bytes() const {
   return binary.bytes() + wide.bytes() + all.size() * sizeof(BvhTriangle) + leaves.size() * sizeof(LeafBox) +
-         two_level.bytes();
+         rects.size() * sizeof(AxisRect) + two_level.bytes();
 }
 uint32_t SceneBvhHost::nodes() const {
-  return uint32_t(binary.nodes.size() + wide.nodes.size() + leaves.size() + two_level.top_nodes.size() +
+  if (layout == GpuBvhLayout::Rects) return uint32_t(rects.size());  // its leaves serve Moeller-Trumbore only
+  return uint32_t(binary.nodes.size() + wide.nodes.size() + leaves.size() + rects.size() + two_level.top_nodes.size() +
                   two_level.bottom_nodes.size());
 }
 uint32_t SceneBvhHost::node_bytes() const {
   if (layout == GpuBvhLayout::Brute) return 0;
   if (layout == GpuBvhLayout::Leaves) return uint32_t(sizeof(LeafBox));
+  if (layout == GpuBvhLayout::Rects) return uint32_t(sizeof(AxisRect));
   return layout == GpuBvhLayout::Binary || layout == GpuBvhLayout::TwoLevel ? uint32_t(sizeof(BvhNode))
                                                                             : uint32_t(sizeof(WideNode));
 }

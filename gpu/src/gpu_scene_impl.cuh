@@ -25,6 +25,7 @@ struct GpuScene::Impl {
   DeviceBuffer<BvhNode> nodes;      // the layout's nodes: binary...
   DeviceBuffer<WideNode> wide_nodes;  // ...or wide (brute force has none)
   DeviceBuffer<LeafBox> leaf_boxes;  // ...or the leaves layout's boxes
+  DeviceBuffer<AxisRect> rects;      // ...or the rects layout's rectangles (axis_plane.h)
   DeviceBuffer<BvhTriangle> tris;    // in traversal order (brute force: scene order)
   // The two-level BVH's (two_level_bvh.h; its triangles are `positions` and `triangles`).
   DeviceBuffer<BvhNode> top_nodes, bottom_nodes;

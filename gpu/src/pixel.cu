@@ -93,10 +93,11 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
 // at every count but kPixelLatencyBlocks and the binary BVH's at 5 and 8. run_pixel
 // dispatches on these, pixel_blocks and pixel_occupancy choose within them.
 constexpr bool compiled_for_five_blocks(int kind) {
-  return kind == int(TraversalKind::Wide) || kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Binary);
+  return kind == int(TraversalKind::Wide) || kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Binary) ||
+         kind == int(TraversalKind::Rects);
 }
 constexpr bool parked_compiled(int kind, int blocks) {
-  return (kind == int(TraversalKind::Leaves) && blocks != kPixelLatencyBlocks) ||
+  return ((kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Rects)) && blocks != kPixelLatencyBlocks) ||
          (kind == int(TraversalKind::Binary) && blocks >= 5);
 }
 static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kPixelLatencyBlocks == 8,
@@ -126,7 +127,7 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   PixelOccupancy o = pixel_blocks(g);
-  const bool leaves = g.bvh.kind == TraversalKind::Leaves;
+  const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
   const std::string v = env ? env : "auto";
   if (v == "auto") o.parked = leaves;

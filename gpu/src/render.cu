@@ -343,6 +343,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
               {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
                           : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"
                           : g.layout == GpuBvhLayout::Leaves ? "embree rtcBuildBVH, binned SAH, binary: its leaves, no inner nodes"
+                          : g.layout == GpuBvhLayout::Rects ? "none: the triangles paired into axis-aligned rectangles"
                           : g.layout == GpuBvhLayout::TwoLevel
                               ? "embree rtcBuildBVH, binned SAH, binary: over the instances, and one per prototype"
                               : "embree rtcBuildBVH, binned SAH, binary (leaves <= 3), collapsed greedily"}};

@@ -29,7 +29,9 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.nodes.assign(bvh.binary.nodes, "BVH nodes", lower);
   m.wide_nodes.assign(bvh.wide.nodes, "BVH nodes", lower);
   m.leaf_boxes.assign(bvh.leaves, "BVH nodes", lower);
-  const bool binary_tris = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::Leaves;
+  m.rects.assign(bvh.rects, "BVH nodes", lower);
+  const bool binary_tris = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::Leaves ||
+                           bvh.layout == GpuBvhLayout::Rects;  // rects: its leaves, for Moeller-Trumbore
   m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : binary_tris ? bvh.binary.tris : bvh.wide.tris,
                 "BVH triangles", lower);
   const TwoLevelHost& two = bvh.two_level;
@@ -53,9 +55,13 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh.tris = m.tris.get();
   m.bvh.leaves = {m.leaf_boxes.get(), m.tris.get(), uint32_t(m.leaf_boxes.size()), uint32_t(m.tris.size()),
                 m.bvh.exact_ties};
+  if (bvh.layout == GpuBvhLayout::Rects) {  // the leaves layout's kernels, on the rectangles
+    m.bvh.leaves.rects = m.rects.get();
+    m.bvh.leaves.rect_groups = bvh.rect_groups;
+  }
   m.bvh.two_level = {m.top_nodes.get(), m.top_items.get(), m.instances.get(), m.bottom_nodes.get(),
                      m.bottom_items.get(), m.positions.get(), m.triangles.get()};
-  m.bvh_bytes = m.nodes.bytes() + m.wide_nodes.bytes() + m.leaf_boxes.bytes() + m.tris.bytes() + m.top_nodes.bytes() +
+  m.bvh_bytes = m.nodes.bytes() + m.wide_nodes.bytes() + m.leaf_boxes.bytes() + m.rects.bytes() + m.tris.bytes() + m.top_nodes.bytes() +
                 m.bottom_nodes.bytes() + m.top_items.bytes() + m.bottom_items.bytes() + m.instances.bytes();
   m.bytes = m.positions.bytes() + m.triangles.bytes() + m.material_ids.bytes() + m.materials.bytes() +
             m.emitters.bytes() + m.emitter_cdf.bytes() + m.bvh_bytes;
@@ -70,6 +76,10 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   if (bvh.layout == GpuBvhLayout::Leaves) {  // one level: the leaves
     m.bvh_depth = 1;
     m.bvh_leaves = uint32_t(bvh.leaves.size());
+  }
+  if (bvh.layout == GpuBvhLayout::Rects) {  // one level: the rectangles
+    m.bvh_depth = 1;
+    m.bvh_leaves = uint32_t(bvh.rects.size());
   }
   if (bvh.layout == GpuBvhLayout::TwoLevel) {  // the deepest top-to-triangle path; triangle references
     m.bvh_depth = two.top_depth + two.bottom_depth;

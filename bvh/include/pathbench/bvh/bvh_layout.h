@@ -5,14 +5,19 @@
 //   brute   no BVH: every triangle tested (brute_force.h), for tiny scenes;
 //   leaves  the binary BVH's leaves, each with its box, and no inner nodes
 //           (leaf_list.h), for tiny scenes without instances;
+//   rects   the scene as axis-aligned rectangles (axis_plane.h: every triangle half of
+//           one), each tested as a flat box, no triangle test (TraversalKind::Rects,
+//           its arrays in LeafListView::rects);
 //   auto    brute at most `brute_max_triangles` triangles, else leaves up to
-//           kLeavesAutoMaxTriangles (a scene without instances), else kAutoLayout;
+//           kLeavesAutoMaxTriangles (a scene without instances) -- rects where every
+//           triangle pairs into an axis-aligned rectangle --, else kAutoLayout;
 //   two-level  the instanced scene's (two_level_bvh.h): not asked for by name but by
 //           GpuBvhOptions::instancing (--instancing), on a scene with instances.
 // The choice comes from GpuBvhOptions (GpuScene's constructor: one process can A/B
 // them), by default from the environment: PATHBENCH_GPU_BVH=<name>,
 // PATHBENCH_GPU_BRUTE_MAX_TRIS=<n>. Plain C++ (tests build it without CUDA).
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -27,7 +32,9 @@
 
 namespace pb::bvh {
 
-enum class GpuBvhLayout : uint32_t { Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6 };
+enum class GpuBvhLayout : uint32_t {
+  Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6, Rects = 7
+};
 
 // Measured on an H100 (results/nvidia-h100-80gb-hbm3/archive/layouts-a12fc4c, interleaved,
 // CUDA events; before the leaves layout existed): the binary BVH is the fastest everywhere we measured — paper-cornell
@@ -50,6 +57,11 @@ constexpr uint32_t kBruteMaxTrianglesLimit = 1u << 16;  // beyond that brute for
 // -> 15.29; paper-cornell-ico:0 (34) 20.63 -> 20.57; ico:1 (94) 23.49 -> 32.30: every box is
 // tested for every ray, so it pays only while the leaves are few.
 constexpr uint32_t kLeavesAutoMaxTriangles = 32;
+// Where auto would take leaves and every triangle pairs into an axis-aligned rectangle
+// (build_axis_rects), it takes rects. Measured on an H100 at f37e775
+// (results/nvidia-h100-80gb-hbm3/archive/rects-f37e775, 256x256x800 nee, interleaved against
+// main 2232aee's leaves): paper-cornell pixel 10.19 -> 7.42 ms, wavefront 13.57 -> 12.63,
+// paper-queue 15.49 -> 14.14; raw incoherent closest hits 27.6 -> 49.7 G rays/s.
 // The leaves layout tests every leaf's box for every ray: asked for by name, up to this many.
 constexpr uint32_t kLeavesMaxTriangles = 1u << 16;
 
@@ -78,6 +90,8 @@ struct SceneBvhHost {
   WideBvhHost wide;                // Wide4, Wide8
   std::vector<BvhTriangle> all;    // Brute: the triangles in scene order
   std::vector<LeafBox> leaves;    // Leaves: the leaves of `binary`, whose triangles it keeps (no nodes)
+  std::vector<AxisRect> rects;    // Rects: the rectangles, grouped by plane axis (rect_groups)
+  RectGroups rect_groups;
   TwoLevelHost two_level;          // TwoLevel
   uint32_t binary_depth = 0, binary_leaves = 0;  // the binary BVH the wide one came from
   double binary_sah = 0, build_seconds = 0;
@@ -92,6 +106,12 @@ struct SceneBvhHost {
 };
 
 SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options);
+
+// The scene's triangles paired into axis-aligned rectangles (axis_plane.h), each pair's
+// four corners exactly {u0, u1} x {v0, v1} in one plane k = c, grouped by k and within a
+// group by lower triangle id. False (and `why` says which triangle) where a triangle is
+// not half of such a rectangle.
+bool build_axis_rects(const Scene& scene, std::vector<AxisRect>& rects, RectGroups& groups, std::string* why = nullptr);
 
 // What a report says of --instancing for the structure `bvh` built for `scene`: asked, used,
 // why, instances and prototypes (the scene's and those built), triangles left flat, the

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "pathbench/bvh/axis_plane.h"
 #include "pathbench/bvh/hit_tests.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
@@ -34,6 +35,10 @@ struct LeafListView {
   uint32_t num_leaves;
   uint32_t num_tris;
   uint32_t exact_ties = 0;  // as BinaryBvhView's
+  // GpuBvhLayout::Rects (axis_plane.h, TraversalKind::Rects): the scene as axis-aligned
+  // rectangles, traced instead of the leaves (no boxes, no triangle tests).
+  const AxisRect* rects = nullptr;
+  RectGroups rect_groups{};
 };
 
 // Leaves a ray keeps in one mask: larger scenes are walked 32 leaves at a time.
@@ -42,17 +47,8 @@ constexpr uint32_t kLeafGroup = 32;
 namespace detail {
 
 PB_HD void load_leaf(const LeafBox* leaves, uint32_t i, float (&lo)[3], float (&hi)[3], uint32_t& ref) {
-#if defined(__CUDA_ARCH__)
-  const float4* p = reinterpret_cast<const float4*>(leaves + i);
-  const float4 a = __ldg(p), b = __ldg(p + 1);
-  lo[0] = a.x; lo[1] = a.y; lo[2] = a.z;
-  ref = __float_as_uint(a.w);
-  hi[0] = b.x; hi[1] = b.y; hi[2] = b.z;
-#else
-  const LeafBox& l = leaves[i];
-  for (int k = 0; k < 3; ++k) { lo[k] = l.lo[k]; hi[k] = l.hi[k]; }
-  ref = l.ref;
-#endif
+  uint32_t pad;
+  load_box_record(leaves, i, lo, hi, ref, pad);
 }
 
 // Leaf i's box entered before t (slab_interval, as a binary node's child); its ref.

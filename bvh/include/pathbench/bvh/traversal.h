@@ -20,8 +20,10 @@ namespace pb::bvh {
 // Binary: binary_bvh.h. Wide: wide_bvh.h (4- or 8-wide, one node format). AllTriangles:
 // brute_force.h, the triangles in scene order in `tris` and no nodes. TwoLevel:
 // two_level_bvh.h, the instanced scene's (--instancing). Leaves: leaf_list.h, the binary
-// BVH's leaves without its inner nodes (tiny scenes without instances).
-enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3, Leaves = 4 };
+// BVH's leaves without its inner nodes (tiny scenes without instances). Rects: axis_plane.h,
+// the scene's axis-aligned rectangles (in LeafListView::rects), no triangle test.
+// (5 is kBinaryExactTies below.)
+enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3, Leaves = 4, Rects = 6 };
 
 struct BvhView {
   BvhView() = default;
@@ -59,6 +61,10 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
     return traverse_two_level<kAnyHit, kWatertight>(bvh.two_level, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::Leaves)) {
     return traverse_leaves<kAnyHit, kWatertight, 0>(bvh.leaves, o, d, t_max, t_hit, stats);  // no instances: no ties rule
+  } else if constexpr (kKind == int(TraversalKind::Rects) && kWatertight) {
+    return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::Rects)) {  // Moeller-Trumbore asked for: the leaves it keeps
+    return traverse_leaves<kAnyHit, false, 0>(bvh.leaves, o, d, t_max, t_hit, stats);
   } else {
     switch (bvh.kind) {
       case TraversalKind::Wide: return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
@@ -67,6 +73,9 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       case TraversalKind::AllTriangles:
         return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
       case TraversalKind::Leaves: return traverse_leaves<kAnyHit, kWatertight>(bvh.leaves, o, d, t_max, t_hit, stats);
+      case TraversalKind::Rects:  // a triangle test (Moeller-Trumbore) asked for: the leaves the layout keeps
+        if constexpr (!kWatertight) return traverse_leaves<kAnyHit, false>(bvh.leaves, o, d, t_max, t_hit, stats);
+        else return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
       default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
     }
   }
@@ -93,6 +102,7 @@ decltype(auto) with_traversal_kind(const BvhView& bvh, Fn&& fn) {
     case TraversalKind::AllTriangles: return fn(std::integral_constant<int, int(TraversalKind::AllTriangles)>{});
     case TraversalKind::TwoLevel: return fn(std::integral_constant<int, int(TraversalKind::TwoLevel)>{});
     case TraversalKind::Leaves: return fn(std::integral_constant<int, int(TraversalKind::Leaves)>{});
+    case TraversalKind::Rects: return fn(std::integral_constant<int, int(TraversalKind::Rects)>{});
     default: return fn(std::integral_constant<int, int(TraversalKind::Binary)>{});
   }
 }
