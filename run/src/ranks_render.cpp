@@ -279,8 +279,12 @@ bool render_ranks(const Scene& scene, const RenderSettings& settings, Film& film
   }
   // PATHBENCH_RANK_FILM_HASH=1 (diagnostics, issue 30): each CPU rank's own film before the
   // reduction, hashed into its report entry, so that runs that differ say whether a rank's
-  // samples or the reduction did. Costs rank 0 a pass over its film inside the frame.
-  const std::string part_hash = rank_film_hash && s.device == Device::Cpu ? film_hash(film) : std::string();
+  // samples or the reduction did. Costs each such rank a pass over its film inside the frame,
+  // which the others wait for in the reduction's agreement: a rank that traced nothing (the
+  // hybrid's CPU rank beside a GPU that took the frame) holds the zero film and hashes nothing
+  // (at 2048x2048 that pass delayed the 2 x H100 hybrid's frame by ~25 ms, 0.97x the GPU alone).
+  const std::string part_hash =
+      rank_film_hash && s.device == Device::Cpu && samples > 0 ? film_hash(film) : std::string();
   const double busy_wall = since(t0);
   const Clock::time_point r0 = Clock::now();
   const double wait_seconds = std::chrono::duration<double>(r0 - t0).count() - mine.seconds;

@@ -31,8 +31,8 @@
 #                 layout, probe times and all (each rank once timed its own probe beside the
 #                 others' start: one rank of three picked triangles, a film other than one
 #                 process's with the same image bytes; issue 30), and the film is one process's
-# rank_film_hash  PATHBENCH_RANK_FILM_HASH=1: each CPU rank's own film hash in its report entry;
-#                 another value (yes) refused, exit 2, no image
+# rank_film_hash  PATHBENCH_RANK_FILM_HASH=1: each CPU rank's own film hash in its report entry,
+#                 none for a rank granted no samples; another value (yes) refused, exit 2, no image
 # packets        paper-cornell-ico:1 (94 triangles: above the tiny test, so Embree's packets
 #                 answer the pixel strategy's rays, and a ray at an edge by its packet mates),
 #                 40 spp over 3 ranks, static and dynamic: each rank's samples are whole
@@ -169,6 +169,18 @@ EOF_PY
     run -x PATHBENCH_RANK_FILM_HASH -np 2 "$pb" $frame --out x.pfm --report x.json
     [ "$status" = 0 ] || { cat err.txt >&2; fail "status $status"; }
     [ "$(grep -c '"film_hash": "fnv1a64:' x.json)" = 3 ] || fail "not a film hash for each rank and the frame"
+    # A rank granted nothing (idle_rank's frame) hashes nothing: its zero film's pass would
+    # only delay the others' reduction.
+    run -x PATHBENCH_RANK_FILM_HASH -np 3 "$pb" render --quiet --width 8 --height 8 --bounces 2 --spp 2 \
+      --balance dynamic --out z.pfm --report z.json
+    [ "$status" = 0 ] || { cat err.txt >&2; fail "idle rank: status $status"; }
+    python3 - z.json <<'EOF_PY' || fail "a rank that traced nothing hashed its film, or a rank that traced did not"
+import json, sys
+ranks = json.load(open(sys.argv[1]))["ranks"]["per_rank"]
+assert any(e["samples"] == 0 for e in ranks), "no rank was idle"
+for e in ranks:
+    assert ("film_hash" in e) == (e["samples"] > 0), e
+EOF_PY
     export PATHBENCH_RANK_FILM_HASH=yes
     run -x PATHBENCH_RANK_FILM_HASH -np 2 "$pb" $frame --out y.pfm
     unset PATHBENCH_RANK_FILM_HASH
