@@ -43,6 +43,20 @@ inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b
 
 inline FV splat(float x) { return FV{} + x; }
 inline FV splat(FV x) { return x; }
+// x in every lane as one broadcast instruction: splat's + 0.0f must be kept (it turns -0.0
+// into +0.0), so the compiler cannot make it one. For values whose sign of zero does not
+// matter (the tiny-scene test's tables, tiny_x8.h).
+#if PB_SIMD_LANES == 16
+inline FV bcast(const float& x) { return FV(_mm512_set1_ps(x)); }
+#else
+inline FV bcast(const float& x) { return FV(_mm256_set1_ps(x)); }
+#endif
+// kLanes floats from p (any alignment): one load.
+#if PB_SIMD_LANES == 16
+inline FV load_lanes(const float* p) { return FV(_mm512_loadu_ps(p)); }
+#else
+inline FV load_lanes(const float* p) { return FV(_mm256_loadu_ps(p)); }
+#endif
 
 // pb::fmadd (math.h) lane-wise: a * b + c, one rounding (a float operand is broadcast).
 // With math.h's fused vector operations, each the twin of the scalar one.

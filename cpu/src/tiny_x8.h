@@ -66,21 +66,6 @@ struct TinyResult {
   UV id;             // scene triangle of `best`
 };
 
-// kLanes floats from p (any alignment): one load.
-#if PB_SIMD_LANES == 16
-inline FV load_lanes(const float* p) { return FV(_mm512_loadu_ps(p)); }
-#else
-inline FV load_lanes(const float* p) { return FV(_mm256_loadu_ps(p)); }
-#endif
-
-// A table value in every lane: one broadcast (splat adds +0.0f, which the compiler must
-// keep for -0.0; no sign of zero matters to the axis-plane test).
-#if PB_SIMD_LANES == 16
-inline FV bcast(const float& x) { return FV(_mm512_set1_ps(x)); }
-#else
-inline FV bcast(const float& x) { return FV(_mm256_set1_ps(x)); }
-#endif
-
 // The axis-plane test's per-ray data (tiny_scene.h AxisGroup; docs/notes/cpu-log.md gives
 // the argument). Per axis c: 1 / D_c; the edge margin's factors (m = G a_c + b_c, G =
 // |X - R|_inf in the plane); whether a lane may use the test for a plane of normal axis c
