@@ -179,43 +179,41 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
       bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
       bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
     }
-  } else if (out.layout == GpuBvhLayout::Rects ||
-             (out.layout == GpuBvhLayout::Leaves && options.layout == GpuBvhLayout::Auto &&
-              build_axis_rects(scene, out.rects, out.rect_groups))) {
-    // auto: a scene of axis-aligned rectangles (paper-cornell) is traced as rectangles.
-    std::string why;
-    if (!scene.instances.empty())
-      throw InputError(fmt::format("GPU BVH layout rects: scene '{}' has instances, whose ties the rectangles' traversal "
-                                   "does not order as the other layouts do (binary, wide4, wide8, brute or --instancing do)",
-                                   scene.name));
-    if (out.rects.empty() && !build_axis_rects(scene, out.rects, out.rect_groups, &why))
-      throw InputError(fmt::format("GPU BVH layout rects: scene '{}': {} (leaves or binary suit it)", scene.name, why));
-    out.layout = GpuBvhLayout::Rects;
-    // The leaves layout too (a few boxes and the triangles): what --no-watertight's triangle
-    // test (Moeller-Trumbore, the accuracy study's) traces, as the rectangles are a watertight test.
-    out.binary = build_bvh(scene, BvhBuildOptions{});
-    out.leaves = leaf_boxes(out.binary);
-    out.binary.nodes.clear();
   } else {
-    if (out.layout == GpuBvhLayout::Leaves && !scene.instances.empty())
-      throw InputError(fmt::format("GPU BVH layout leaves: scene '{}' has instances, whose ties the leaves traversal does "
-                                   "not order (binary, wide4, wide8, brute or --instancing do)", scene.name));
-    if (out.layout == GpuBvhLayout::Leaves && scene.triangles.size() > kLeavesMaxTriangles)
-      throw InputError(fmt::format("GPU BVH layout leaves: scene '{}' has {} triangles; it tests every leaf's box for "
-                                   "every ray and takes at most {} (binary suits it)", scene.name,
-                                   scene.triangles.size(), kLeavesMaxTriangles));
+    // auto: where it takes leaves and every triangle pairs into an axis-aligned rectangle
+    // (paper-cornell), the rectangles.
+    if (out.layout == GpuBvhLayout::Leaves && options.layout == GpuBvhLayout::Auto &&
+        build_axis_rects(scene, out.rects, out.rect_groups))
+      out.layout = GpuBvhLayout::Rects;
+    // The rects layout keeps the leaves layout too (a few boxes and the triangles): what
+    // --no-watertight's triangle test (Moeller-Trumbore, the accuracy study's) traces, as the
+    // rectangles are a watertight test. Both test every leaf or rectangle for every ray.
+    const bool rects = out.layout == GpuBvhLayout::Rects, leaves = rects || out.layout == GpuBvhLayout::Leaves;
+    const char* name = to_string(out.layout);
+    if (leaves && !scene.instances.empty())
+      throw InputError(fmt::format("GPU BVH layout {}: scene '{}' has instances, whose ties the {} traversal does "
+                                   "not order (binary, wide4, wide8, brute or --instancing do)", name, scene.name, name));
+    if (leaves && scene.triangles.size() > kLeavesMaxTriangles)
+      throw InputError(fmt::format("GPU BVH layout {}: scene '{}' has {} triangles; it tests every {} for "
+                                   "every ray and takes at most {} (binary suits it)", name, scene.name,
+                                   scene.triangles.size(), rects ? "rectangle" : "leaf's box", kLeavesMaxTriangles));
+    std::string why;
+    if (rects && out.rects.empty() && !build_axis_rects(scene, out.rects, out.rect_groups, &why))
+      throw InputError(fmt::format("GPU BVH layout rects: scene '{}': {} (leaves or binary suit it)", scene.name, why));
     const bool wide = out.layout == GpuBvhLayout::Wide4 || out.layout == GpuBvhLayout::Wide8;
     BvhBuildOptions bo = BvhBuildOptions{}.with_env();  // the environment's build overrides (measurements)
     if (wide) bo.max_leaf_size = kWideMaxLeafTris;  // a wide leaf holds up to 3
     out.binary = build_bvh(scene, bo);
-    out.binary_depth = out.binary.depth;
-    out.binary_leaves = out.binary.leaves;
-    out.binary_sah = out.binary.sah_cost;
+    if (!rects) {  // the BVH it traces (rects: the rectangles, as nodes() and the report say)
+      out.binary_depth = out.binary.depth;
+      out.binary_leaves = out.binary.leaves;
+      out.binary_sah = out.binary.sah_cost;
+    }
     if (wide) {
       out.wide = collapse_bvh(out.binary, out.layout == GpuBvhLayout::Wide4 ? 4 : 8);
       out.binary = BvhHost{};
     }
-    if (out.layout == GpuBvhLayout::Leaves) {
+    if (leaves) {
       out.leaves = leaf_boxes(out.binary);
       out.binary.nodes.clear();  // the triangles stay, in leaf order
     }
@@ -266,7 +264,7 @@ uint64_t SceneBvhHost::bytes() const {
 }
 uint32_t SceneBvhHost::nodes() const {
   if (layout == GpuBvhLayout::Rects) return uint32_t(rects.size());  // its leaves serve Moeller-Trumbore only
-  return uint32_t(binary.nodes.size() + wide.nodes.size() + leaves.size() + rects.size() + two_level.top_nodes.size() +
+  return uint32_t(binary.nodes.size() + wide.nodes.size() + leaves.size() + two_level.top_nodes.size() +
                   two_level.bottom_nodes.size());
 }
 uint32_t SceneBvhHost::node_bytes() const {

@@ -356,6 +356,47 @@ TEST(RectsLayout, AutoPicksRectsWhereEveryTriangleIsHalfARectangle) {
   EXPECT_EQ(build_scene_bvh(kite, GpuBvhOptions{}).layout, GpuBvhLayout::Leaves);
 }
 
+// Asked for by name, rects refuses what the leaves layout refuses, naming itself: a scene
+// with instances (its ties), and one past kLeavesMaxTriangles even where every triangle
+// pairs (it tests every rectangle for every ray; before, such a scene was accepted).
+TEST(RectsLayout, RefusesInstancesAndLargeScenes) {
+  GpuBvhOptions o;
+  o.layout = GpuBvhLayout::Rects;
+  Scene strips = load_scene("paper-cornell");  // its materials; a row of unit squares in z = 0
+  strips.positions.clear();
+  strips.triangles.clear();
+  const uint32_t squares = kLeavesMaxTriangles / 2 + 1;
+  for (uint32_t i = 0; i <= squares; ++i) {
+    strips.positions.push_back({float(i), 0.0f, 0.0f});
+    strips.positions.push_back({float(i), 1.0f, 0.0f});
+  }
+  for (uint32_t i = 0; i < squares; ++i) {
+    strips.triangles.push_back({{2 * i, 2 * i + 2, 2 * i + 3}});
+    strips.triangles.push_back({{2 * i, 2 * i + 3, 2 * i + 1}});
+  }
+  strips.material_ids.assign(strips.triangles.size(), 0);
+  ASSERT_GT(strips.triangles.size(), size_t(kLeavesMaxTriangles));
+  std::vector<AxisRect> rects;
+  RectGroups groups;
+  ASSERT_TRUE(build_axis_rects(strips, rects, groups));  // every triangle pairs
+  try {
+    build_scene_bvh(strips, o);
+    ADD_FAILURE() << "rects accepted " << strips.triangles.size() << " triangles";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GPU BVH layout rects"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("takes at most"), std::string::npos) << e.what();
+  }
+  Scene inst = load_scene(std::string(PATHBENCH_SOURCE_DIR) + "/scenes/examples/instancing.json");
+  ASSERT_FALSE(inst.instances.empty());
+  try {
+    build_scene_bvh(inst, o);
+    ADD_FAILURE() << "rects accepted a scene with instances";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GPU BVH layout rects"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("instances"), std::string::npos) << e.what();
+  }
+}
+
 // The rectangles' least t is ray_t_min's, bit for bit; a hit's triangle is the half of
 // its rectangle the hit point lies in, and at a corner of three walls or an edge of two a
 // ray aimed exactly at it from inside hits one of them (the plane t's are compared, a
