@@ -229,12 +229,16 @@ BvhBuildOptions BvhBuildOptions::with_env() const {
   return o;
 }
 
-BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options) {
+BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options, const std::vector<char>* leave_out) {
   if (options.max_leaf_size < 1 || options.max_leaf_size > kMaxLeafPrims)
     throw std::invalid_argument(fmt::format("bvh: max_leaf_size must be 1..{}", kMaxLeafPrims));
   const auto t0 = std::chrono::steady_clock::now();
   BvhHost out;
-  const size_t n = scene.triangles.size();
+  std::vector<uint32_t> ids;  // the scene triangles in the BVH
+  ids.reserve(scene.triangles.size());
+  for (uint32_t i = 0; i < scene.triangles.size(); ++i)
+    if (!leave_out || !(*leave_out)[i]) ids.push_back(i);
+  const size_t n = ids.size();
 
   // Pad boxes by a few ulps of the scene's largest coordinate: the slab test's
   // rounding (fused or not) then never culls a box a ray really touches.
@@ -261,10 +265,10 @@ BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options) {
   std::vector<RTCBuildPrimitive> prims(capacity);
   for (size_t i = 0; i < n; ++i) {
     Box b;
-    for (int k = 0; k < 3; ++k) b.grow(scene.positions[scene.triangles[i].v[k]]);
+    for (int k = 0; k < 3; ++k) b.grow(scene.positions[scene.triangles[ids[i]].v[k]]);
     RTCBuildPrimitive& p = prims[i];
     p.lower_x = b.lo.x; p.lower_y = b.lo.y; p.lower_z = b.lo.z; p.geomID = 0;
-    p.upper_x = b.hi.x; p.upper_y = b.hi.y; p.upper_z = b.hi.z; p.primID = unsigned(i);
+    p.upper_x = b.hi.x; p.upper_y = b.hi.y; p.upper_z = b.hi.z; p.primID = ids[i];
   }
 
   RTCBuildArguments args = rtcDefaultBuildArguments();

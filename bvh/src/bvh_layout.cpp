@@ -6,7 +6,9 @@
 #include <charconv>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <string>
+#include <unordered_map>
 
 #include "pathbench/common/errors.h"
 #include "pathbench/common/report.h"
@@ -19,7 +21,7 @@ constexpr struct {
   const char* name;
 } kNames[] = {{GpuBvhLayout::Auto, "auto"},   {GpuBvhLayout::Binary, "binary"}, {GpuBvhLayout::Wide4, "wide4"},
               {GpuBvhLayout::Wide8, "wide8"}, {GpuBvhLayout::Brute, "brute"},   {GpuBvhLayout::Leaves, "leaves"},
-              {GpuBvhLayout::Rects, "rects"}};
+              {GpuBvhLayout::Rects, "rects"}, {GpuBvhLayout::RectsBinary, "rects-binary"}};
 
 // The binary BVH's leaves in depth-first order, each with the box its parent node holds
 // for it (padded by the builder), for the leaves layout.
@@ -126,6 +128,89 @@ bool build_axis_rects(const Scene& scene, std::vector<AxisRect>& rects, RectGrou
   return n > 0;
 }
 
+namespace {
+// Triangle i's rectangle key where it could be half of an axis-aligned rectangle: its plane
+// axis and value, and its box in the other two axes (a half's box is the whole rectangle).
+struct RectKey {
+  int axis;
+  float c, u0, u1, v0, v1;
+  bool operator==(const RectKey&) const = default;
+};
+struct RectKeyHash {
+  size_t operator()(const RectKey& k) const {
+    uint64_t h = uint64_t(k.axis);
+    for (float f : {k.c, k.u0, k.u1, k.v0, k.v1}) {
+      uint32_t b;
+      std::memcpy(&b, &f, 4);
+      h = (h ^ b) * 0x100000001b3ull;
+    }
+    return size_t(h);
+  }
+};
+bool rect_key(const Scene& scene, uint32_t i, RectKey& key) {
+  const Triangle& t = scene.triangles[i];
+  const Vec3f a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
+  for (int k = 0; k < 3; ++k) {
+    if (a[k] != b[k] || a[k] != c[k]) continue;
+    const int u = k == 2 ? 0 : k + 1, v = u == 2 ? 0 : u + 1;
+    key = {k, a[k], std::min({a[u], b[u], c[u]}), std::max({a[u], b[u], c[u]}), std::min({a[v], b[v], c[v]}),
+           std::max({a[v], b[v], c[v]})};
+    return key.u0 < key.u1 && key.v0 < key.v1;
+  }
+  return false;
+}
+}  // namespace
+
+double largest_axis_rects(const Scene& scene, uint32_t max_rects, std::vector<AxisRect>& rects, RectGroups& groups,
+                          std::vector<char>& in_rect) {
+  const size_t n = scene.triangles.size();
+  in_rect.assign(n, 0);
+  rects.clear();
+  groups = RectGroups{};
+  // Unpaired candidates by key; a triangle pairs with the first earlier one make_axis_rect takes.
+  std::unordered_map<RectKey, std::vector<uint32_t>, RectKeyHash> open;
+  struct Found {
+    AxisRect r;
+    int axis;
+    double area;
+  };
+  std::vector<Found> found;
+  for (uint32_t i = 0; i < n; ++i) {
+    RectKey key;
+    if (!rect_key(scene, i, key)) continue;
+    std::vector<uint32_t>& waiting = open[key];
+    bool paired = false;
+    for (size_t w = 0; w < waiting.size() && !paired; ++w) {
+      Found f;
+      if (!make_axis_rect(scene, waiting[w], i, f.r, f.axis)) continue;
+      f.area = double(key.u1 - key.u0) * double(key.v1 - key.v0);
+      found.push_back(f);
+      waiting.erase(waiting.begin() + long(w));
+      paired = true;
+    }
+    if (!paired) waiting.push_back(i);
+  }
+  // The largest first; of equal areas the lower ids (a stable order whatever the hash did).
+  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) {
+    return a.area != b.area ? a.area > b.area : a.r.key < b.r.key;
+  });
+  if (found.size() > max_rects) found.resize(max_rects);
+  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) {
+    return a.axis != b.axis ? a.axis < b.axis : a.r.key < b.r.key;
+  });
+  double area = 0;
+  for (const Found& f : found) {
+    rects.push_back(f.r);
+    groups.end[f.axis] = uint32_t(rects.size());
+    in_rect[f.r.key] = in_rect[f.r.other & kRectIdMask] = 1;
+    area += f.area;
+  }
+  for (int k = 1; k < 3; ++k) groups.end[k] = std::max(groups.end[k], groups.end[k - 1]);
+  const Vec3f e = scene.bounds_max - scene.bounds_min;
+  const double surface = 2.0 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
+  return surface > 0 ? area / surface : 0.0;
+}
+
 const char* to_string(GpuBvhLayout l) {
   if (l == GpuBvhLayout::TwoLevel) return "two-level";  // chosen by --instancing, not by name
   for (const auto& n : kNames)
@@ -136,7 +221,7 @@ const char* to_string(GpuBvhLayout l) {
 GpuBvhLayout parse_gpu_bvh_layout(std::string_view name, std::string_view what) {
   for (const auto& n : kNames)
     if (name == n.name) return n.layout;
-  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute, leaves, rects)", what, name));
+  throw InputError(fmt::format("{}: '{}' is not a GPU BVH layout (auto, binary, wide4, wide8, brute, leaves, rects, rects-binary)", what, name));
 }
 
 GpuBvhOptions GpuBvhOptions::from_env(Instancing instancing) {
@@ -162,6 +247,48 @@ GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles, size_t ins
   return triangles <= kLeavesAutoMaxTriangles && instances == 0 ? GpuBvhLayout::Leaves : kAutoLayout;
 }
 
+namespace {
+// rects-binary (rects_binary.h), asked for by name (`asked`: a scene it cannot trace is an
+// InputError) or by auto (taken where the rectangles cover kRectsBinaryAutoCover of the
+// scene box's surface; else `out` is left as it was).
+void build_rects_binary(const Scene& scene, bool asked, SceneBvhHost& out) {
+  if (asked && !scene.instances.empty())
+    throw InputError(fmt::format("GPU BVH layout rects-binary: scene '{}' has instances, whose ties it does not order "
+                                 "(binary, wide4, wide8, brute or --instancing do)", scene.name));
+  std::vector<char> in_rect;
+  const double cover = largest_axis_rects(scene, kRectsBinaryMaxRects, out.rects, out.rect_groups, in_rect);
+  const size_t walls = 2 * out.rects.size();
+  if (asked && walls == 0)
+    throw InputError(fmt::format("GPU BVH layout rects-binary: scene '{}' has no two triangles that make an "
+                                 "axis-aligned rectangle (binary suits it)", scene.name));
+  if (asked && walls == scene.triangles.size())
+    throw InputError(fmt::format("GPU BVH layout rects-binary: every triangle of scene '{}' is half of an "
+                                 "axis-aligned rectangle (rects suits it)", scene.name));
+  if (!asked && (walls == 0 || walls == scene.triangles.size() || cover < kRectsBinaryAutoCover)) {
+    out.rects.clear();
+    out.rect_groups = RectGroups{};
+    return;
+  }
+  out.layout = GpuBvhLayout::RectsBinary;
+  out.binary = build_bvh(scene, BvhBuildOptions{}.with_env(), &in_rect);
+  out.binary_depth = out.binary.depth;
+  out.binary_leaves = out.binary.leaves;
+  out.binary_sah = out.binary.sah_cost;
+  // The rectangles' triangles after the BVH's, for Moeller-Trumbore (rects_binary.h).
+  for (const AxisRect& r : out.rects)
+    for (uint32_t id : {r.key, r.other & kRectIdMask}) {
+      const Triangle& t = scene.triangles[id];
+      const Vec3f a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
+      BvhTriangle bt{};
+      bt.v0[0] = a.x; bt.v0[1] = a.y; bt.v0[2] = a.z; bt.prim = id;
+      bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
+      bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
+      out.binary.tris.push_back(bt);
+    }
+  out.rect_tris = uint32_t(walls);
+}
+}  // namespace
+
 SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   SceneBvhHost out;
@@ -179,7 +306,13 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
       bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
       bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
     }
-  } else {
+  } else if (out.layout == GpuBvhLayout::RectsBinary ||
+             (out.layout == kAutoLayout && options.layout == GpuBvhLayout::Auto && scene.instances.empty() &&
+              scene.triangles.size() > kLeavesAutoMaxTriangles)) {
+    build_rects_binary(scene, options.layout == GpuBvhLayout::RectsBinary, out);
+  }
+  if (out.layout != GpuBvhLayout::TwoLevel && out.layout != GpuBvhLayout::Brute &&
+      out.layout != GpuBvhLayout::RectsBinary) {
     // auto: where it takes leaves and every triangle pairs into an axis-aligned rectangle
     // (paper-cornell), the rectangles.
     if (out.layout == GpuBvhLayout::Leaves && options.layout == GpuBvhLayout::Auto &&
@@ -250,6 +383,13 @@ BvhView SceneBvhHost::view() const {
       v.leaves.rects = rects.data();
       v.leaves.rect_groups = rect_groups;
       break;
+    case GpuBvhLayout::RectsBinary: {
+      v.kind = TraversalKind::RectsBinary;
+      BinaryBvhView rest = binary.view();
+      rest.num_tris -= rect_tris;
+      v.rects_binary = {rest, rects.data(), rect_groups, binary.tris.data() + rest.num_tris, rect_tris};
+      break;
+    }
     default:
       v.kind = TraversalKind::Binary;
       v.binary = binary.view();
@@ -271,8 +411,9 @@ uint32_t SceneBvhHost::node_bytes() const {
   if (layout == GpuBvhLayout::Brute) return 0;
   if (layout == GpuBvhLayout::Leaves) return uint32_t(sizeof(LeafBox));
   if (layout == GpuBvhLayout::Rects) return uint32_t(sizeof(AxisRect));
-  return layout == GpuBvhLayout::Binary || layout == GpuBvhLayout::TwoLevel ? uint32_t(sizeof(BvhNode))
-                                                                            : uint32_t(sizeof(WideNode));
+  return layout == GpuBvhLayout::Binary || layout == GpuBvhLayout::TwoLevel || layout == GpuBvhLayout::RectsBinary
+             ? uint32_t(sizeof(BvhNode))
+             : uint32_t(sizeof(WideNode));
 }
 
 nlohmann::json instancing_report(const Scene& scene, const SceneBvhHost& bvh, Instancing asked) {

@@ -344,6 +344,8 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
                           : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"
                           : g.layout == GpuBvhLayout::Leaves ? "embree rtcBuildBVH, binned SAH, binary: its leaves, no inner nodes"
                           : g.layout == GpuBvhLayout::Rects ? "none: the triangles paired into axis-aligned rectangles"
+                          : g.layout == GpuBvhLayout::RectsBinary
+                              ? "the largest axis-aligned rectangles first, then embree rtcBuildBVH, binned SAH, binary over the rest"
                           : g.layout == GpuBvhLayout::TwoLevel
                               ? "embree rtcBuildBVH, binned SAH, binary: over the instances, and one per prototype"
                               : "embree rtcBuildBVH, binned SAH, binary (leaves <= 3), collapsed greedily"}};

@@ -31,7 +31,8 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.leaf_boxes.assign(bvh.leaves, "BVH nodes", lower);
   m.rects.assign(bvh.rects, "BVH nodes", lower);
   const bool binary_tris = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::Leaves ||
-                           bvh.layout == GpuBvhLayout::Rects;  // rects: its leaves, for Moeller-Trumbore
+                           bvh.layout == GpuBvhLayout::Rects ||  // rects: its leaves, for Moeller-Trumbore
+                           bvh.layout == GpuBvhLayout::RectsBinary;  // the rest's, then the rectangles'
   m.tris.assign(bvh.layout == GpuBvhLayout::Brute ? bvh.all : binary_tris ? bvh.binary.tris : bvh.wide.tris,
                 "BVH triangles", lower);
   const TwoLevelHost& two = bvh.two_level;
@@ -59,6 +60,13 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
     m.bvh.leaves.rects = m.rects.get();
     m.bvh.leaves.rect_groups = bvh.rect_groups;
   }
+  if (bvh.layout == GpuBvhLayout::RectsBinary) {  // the host view's counts, the device's arrays
+    RectsBinaryView& rb = m.bvh.rects_binary;
+    rb.rest.nodes = m.nodes.get();
+    rb.rest.tris = m.tris.get();
+    rb.rects = m.rects.get();
+    rb.rect_tris = m.tris.get() + rb.rest.num_tris;
+  }
   m.bvh.two_level = {m.top_nodes.get(), m.top_items.get(), m.instances.get(), m.bottom_nodes.get(),
                      m.bottom_items.get(), m.positions.get(), m.triangles.get()};
   m.bvh_bytes = m.nodes.bytes() + m.wide_nodes.bytes() + m.leaf_boxes.bytes() + m.rects.bytes() + m.tris.bytes() + m.top_nodes.bytes() +
@@ -71,8 +79,9 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh_nodes = bvh.nodes();
   m.bvh_node_bytes = bvh.node_bytes();
   m.bvh_tris = uint32_t(m.tris.size());
-  m.bvh_depth = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_depth : bvh.wide.depth;
-  m.bvh_leaves = bvh.layout == GpuBvhLayout::Binary ? bvh.binary_leaves : bvh.wide.leaves;
+  const bool binary = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::RectsBinary;
+  m.bvh_depth = binary ? bvh.binary_depth : bvh.wide.depth;
+  m.bvh_leaves = binary ? bvh.binary_leaves : bvh.wide.leaves;
   if (bvh.layout == GpuBvhLayout::Leaves) {  // one level: the leaves
     m.bvh_depth = 1;
     m.bvh_leaves = uint32_t(bvh.leaves.size());

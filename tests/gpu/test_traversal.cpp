@@ -1,7 +1,7 @@
 // Host-side checks of the GPU tracer's BVH (built by Embree's builder) and its
 // host+device traversal with the watertight triangle test, against Embree's own
 // intersector on the same rays, in every layout (binary, wide4, wide8, brute force,
-// leaves: bvh_layout.h); the other layouts also against the binary BVH, hit for hit. Runs without a GPU (CTest label `unit`).
+// leaves, rects, rects-binary: bvh_layout.h); the other layouts also against the binary BVH, hit for hit. Runs without a GPU (CTest label `unit`).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -89,7 +89,10 @@ TEST_P(Traversal, BvhReferencesEveryTriangle) {
     for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i;
     return;
   }
-  const bool binary_tris = bvh_.layout == GpuBvhLayout::Binary || bvh_.layout == GpuBvhLayout::Leaves;
+  // rects-binary: the rest's triangles, then the rectangles' (each triangle once: checked in
+  // RectsBinaryLayout.AutoTakesTheWallsOfARoom).
+  const bool binary_tris = bvh_.layout == GpuBvhLayout::Binary || bvh_.layout == GpuBvhLayout::Leaves ||
+                           bvh_.layout == GpuBvhLayout::RectsBinary;
   const std::vector<BvhTriangle>& tris = bvh_.layout == GpuBvhLayout::Brute ? bvh_.all
                                          : binary_tris                      ? bvh_.binary.tris
                                                                             : bvh_.wide.tris;
@@ -99,8 +102,9 @@ TEST_P(Traversal, BvhReferencesEveryTriangle) {
     seen[t.prim] = 1;
   }
   for (size_t i = 0; i < seen.size(); ++i) EXPECT_TRUE(seen[i]) << "triangle " << i << " is in no leaf";
-  const uint32_t depth = bvh_.layout == GpuBvhLayout::Binary ? bvh_.binary.depth : bvh_.wide.depth;
-  if (bvh_.layout == GpuBvhLayout::Binary) {
+  const bool binary = bvh_.layout == GpuBvhLayout::Binary || bvh_.layout == GpuBvhLayout::RectsBinary;
+  const uint32_t depth = binary ? bvh_.binary.depth : bvh_.wide.depth;
+  if (binary) {
     EXPECT_FALSE(is_leaf(0));
     EXPECT_LT(depth + 1, uint32_t(kTraversalStackSize));
   }
@@ -212,7 +216,8 @@ INSTANTIATE_TEST_SUITE_P(
                       SceneCase{"paper-cornell", true, GpuBvhLayout::Leaves},
                       SceneCase{"paper-cornell-ico:3", true, GpuBvhLayout::Leaves},
                       SceneCase{"cornell-box", false, GpuBvhLayout::Leaves},
-                      SceneCase{"paper-cornell", true, GpuBvhLayout::Rects}),
+                      SceneCase{"paper-cornell", true, GpuBvhLayout::Rects},
+                      SceneCase{"paper-cornell-ico:3", true, GpuBvhLayout::RectsBinary}),
     case_name);
 
 // Every layout against the binary BVH on the same rays, by the rules the Embree
@@ -311,7 +316,9 @@ INSTANTIATE_TEST_SUITE_P(Layouts, LayoutsAgree,
                                            SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::Wide8},
                                            SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::Wide4},
                                            SceneCase{"cornell-box", false, GpuBvhLayout::Wide8},
-                                           SceneCase{"paper-cornell", true, GpuBvhLayout::Rects}),
+                                           SceneCase{"paper-cornell", true, GpuBvhLayout::Rects},
+                                           SceneCase{"paper-cornell-ico:0", true, GpuBvhLayout::RectsBinary},
+                                           SceneCase{"paper-cornell-ico:4", true, GpuBvhLayout::RectsBinary}),
                          case_name);
 
 // The rectangles at the extremes of scale, and moved off the origin: paper-cornell ten
@@ -322,6 +329,10 @@ TEST(LayoutsAgreeScaled, RectsTinyAndHugeScenes) {
     for (Vec3f& p : scene.positions) p = p * scale + Vec3f{0.5f, -0.25f, 0.125f} * scale;
     scene.finalize();
     expect_same_hits_as_binary(scene, GpuBvhLayout::Rects, "paper-cornell x " + std::to_string(scale));
+    Scene ico = load_scene("paper-cornell-ico:2");
+    for (Vec3f& p : ico.positions) p = p * scale + Vec3f{0.5f, -0.25f, 0.125f} * scale;
+    ico.finalize();
+    expect_same_hits_as_binary(ico, GpuBvhLayout::RectsBinary, "paper-cornell-ico:2 x " + std::to_string(scale));
   }
 }
 
@@ -335,7 +346,7 @@ TEST(RectsLayout, AutoPicksRectsWhereEveryTriangleIsHalfARectangle) {
   EXPECT_EQ(r.nodes(), 7u);
   EXPECT_EQ(r.view().kind, TraversalKind::Rects);
   const Scene ico = load_scene("paper-cornell-ico:0");
-  EXPECT_EQ(build_scene_bvh(ico, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);  // 34 triangles: past the leaves' 32
+  EXPECT_EQ(build_scene_bvh(ico, GpuBvhOptions{}).layout, GpuBvhLayout::RectsBinary);  // 34 triangles: past the leaves' 32
   GpuBvhOptions o;
   o.layout = GpuBvhLayout::Rects;
   try {
@@ -460,6 +471,124 @@ TEST(RectsLayout, MoellerTrumboreTracesTheLeaves) {
   EXPECT_EQ(differ, 0u);
 }
 
+// rects-binary (rects_binary.h): auto takes it where the largest axis-aligned rectangles
+// cover half the scene box's surface (a room's walls around meshes), and the rectangles
+// are the walls and the light; the BVH holds the rest under their scene ids, and the
+// rectangles' triangles follow them for Moeller-Trumbore.
+TEST(RectsBinaryLayout, AutoTakesTheWallsOfARoom) {
+  for (const char* name : {"paper-cornell-ico:0", "paper-cornell-ico:3"}) {
+    const Scene s = load_scene(name);
+    const SceneBvhHost b = build_scene_bvh(s, GpuBvhOptions{});
+    ASSERT_EQ(b.layout, GpuBvhLayout::RectsBinary) << name;
+    EXPECT_EQ(b.rects.size(), 7u) << name;  // 6 walls and the light
+    EXPECT_EQ(b.rect_tris, 14u) << name;
+    const BvhView v = b.view();
+    EXPECT_EQ(v.kind, TraversalKind::RectsBinary);
+    EXPECT_EQ(v.rects_binary.rest.num_tris, s.triangles.size() - 14) << name;
+    EXPECT_EQ(v.rects_binary.num_rect_tris, 14u);
+    std::vector<char> seen(s.triangles.size(), 0);
+    for (uint32_t i = 0; i < v.rects_binary.rest.num_tris; ++i) seen[v.rects_binary.rest.tris[i].prim] += 1;
+    for (uint32_t i = 0; i < 14; ++i) seen[v.rects_binary.rect_tris[i].prim] += 10;
+    for (size_t i = 0; i < s.triangles.size(); ++i)
+      EXPECT_EQ(int(seen[i]), i < 14 ? 10 : 1) << name << ": triangle " << i;  // the box's 14 come first
+  }
+  // Not a room: the Cornell box's measured walls are not exactly axis-aligned, and the few
+  // rectangles it has cover under half its box's surface.
+  const Scene cornell = load_scene("cornell-box");
+  std::vector<AxisRect> rects;
+  RectGroups groups;
+  std::vector<char> in_rect;
+  EXPECT_LT(largest_axis_rects(cornell, kRectsBinaryMaxRects, rects, groups, in_rect), kRectsBinaryAutoCover);
+  EXPECT_EQ(build_scene_bvh(cornell, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);
+  EXPECT_EQ(parse_gpu_bvh_layout("rects-binary"), GpuBvhLayout::RectsBinary);
+}
+
+// Asked for by name, rects-binary refuses a scene it cannot trace, saying why: one whose
+// triangles are all rectangles (rects suits it), one with no rectangle, one with instances.
+TEST(RectsBinaryLayout, RefusesWhatItCannotTrace) {
+  GpuBvhOptions o;
+  o.layout = GpuBvhLayout::RectsBinary;
+  const Scene inst = load_scene(std::string(PATHBENCH_SOURCE_DIR) + "/scenes/examples/instancing.json");
+  Scene sphere = load_scene("paper-cornell-ico:1");  // the icosphere alone
+  sphere.triangles.erase(sphere.triangles.begin(), sphere.triangles.begin() + 14);
+  sphere.material_ids.erase(sphere.material_ids.begin(), sphere.material_ids.begin() + 14);
+  sphere.finalize();
+  for (const auto& [scene, why] : {std::pair{load_scene("paper-cornell"), "rects suits it"},
+                                   std::pair{sphere, "no two triangles"},
+                                   std::pair{inst, "instances"}}) {
+    try {
+      build_scene_bvh(scene, o);
+      ADD_FAILURE() << "rects-binary accepted " << scene.name;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("GPU BVH layout rects-binary"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(build_scene_bvh(inst, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);  // auto: not with instances
+}
+
+// The largest rectangles, at most the limit asked for; of equal areas the lower ids; the
+// cover is their area over the scene box's surface.
+TEST(RectsBinaryLayout, KeepsTheLargestRectangles) {
+  Scene strips = load_scene("paper-cornell");  // its materials; 20 squares of side 1..20 in z = 0, apart
+  strips.positions.clear();
+  strips.triangles.clear();
+  float x = 0;
+  for (uint32_t i = 0; i < 20; ++i) {
+    const float side = float(20 - i);
+    const uint32_t b = uint32_t(strips.positions.size());
+    for (const Vec3f& p : {Vec3f{x, 0, 0}, Vec3f{x + side, 0, 0}, Vec3f{x, side, 0}, Vec3f{x + side, side, 0}})
+      strips.positions.push_back(p);
+    strips.triangles.push_back({{b, b + 1, b + 3}});
+    strips.triangles.push_back({{b, b + 3, b + 2}});
+    x += side + 1;
+  }
+  strips.material_ids.assign(strips.triangles.size(), 0);
+  strips.finalize();
+  std::vector<AxisRect> rects;
+  RectGroups groups;
+  std::vector<char> in_rect;
+  const double cover = largest_axis_rects(strips, 16, rects, groups, in_rect);
+  ASSERT_EQ(rects.size(), 16u);
+  EXPECT_EQ(groups.end[0], 0u);
+  EXPECT_EQ(groups.end[1], 0u);
+  EXPECT_EQ(groups.end[2], 16u);
+  for (uint32_t i = 0; i < 40; ++i) EXPECT_EQ(in_rect[i] != 0, i < 32) << "triangle " << i;
+  double area = 0;
+  for (uint32_t i = 0; i < 16; ++i) {
+    EXPECT_EQ(rects[i].key, 2 * i);
+    area += double(20 - i) * double(20 - i);
+  }
+  const Vec3f e = strips.bounds_max - strips.bounds_min;  // flat: the surface is twice the face
+  EXPECT_NEAR(cover, area / (2.0 * double(e.x) * double(e.y)), 1e-9);
+}
+
+// --no-watertight (Moeller-Trumbore) on rects-binary tests the rectangles' triangles with
+// that test, so its answers are the binary BVH's with Moeller-Trumbore over every triangle.
+TEST(RectsBinaryLayout, MoellerTrumboreTestsTheWallsTriangles) {
+  const Scene s = load_scene("paper-cornell-ico:2");
+  GpuBvhOptions o;
+  o.layout = GpuBvhLayout::Binary;
+  const SceneBvhHost walls = build_scene_bvh(s, GpuBvhOptions{}), binary = build_scene_bvh(s, o);
+  ASSERT_EQ(walls.layout, GpuBvhLayout::RectsBinary);
+  const Vec3f ext = s.bounds_max - s.bounds_min;
+  const auto rays = test::random_rays(s.bounds_min + ext * 0.02f, s.bounds_max - ext * 0.02f, 5000, 31);
+  size_t differ = 0, occlusion_differs = 0;
+  for (const Ray3& r : rays) {
+    float ta = 0, tb = 0, tc = 0;
+    const uint32_t a = traverse<false, false>(walls.view(), r.o, r.d, r.t_max, ta);
+    const uint32_t b = traverse<false, false>(binary.view(), r.o, r.d, r.t_max, tb);
+    const uint32_t c = traverse<false, false, int(TraversalKind::RectsBinary)>(walls.view(), r.o, r.d, r.t_max, tc);
+    differ += a != b || ta != tb || a != c || ta != tc;
+    if (b == kNoHit) continue;
+    const Vec3f d = r.d * (tb * 0.999f);
+    occlusion_differs += (traverse<true, false>(walls.view(), r.o, d, 1.0f, ta) != kNoHit) !=
+                         (traverse<true, false>(binary.view(), r.o, d, 1.0f, tb) != kNoHit);
+  }
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(occlusion_differs, 0u);
+}
+
 // A square split into four triangles around its centre: rays exactly through the shared
 // centre vertex and through points of the shared diagonals hit at least one triangle.
 TEST(Watertight, SharedEdgesAndVertexOfAFan) {
@@ -532,7 +661,7 @@ TEST(BvhLayout, AutoAndNames) {
   o.layout = GpuBvhLayout::Binary;
   EXPECT_EQ(resolve_layout(o, 5), GpuBvhLayout::Binary);
   for (GpuBvhLayout l : {GpuBvhLayout::Auto, GpuBvhLayout::Binary, GpuBvhLayout::Wide4, GpuBvhLayout::Wide8,
-                         GpuBvhLayout::Brute, GpuBvhLayout::Leaves})
+                         GpuBvhLayout::Brute, GpuBvhLayout::Leaves, GpuBvhLayout::Rects, GpuBvhLayout::RectsBinary})
     EXPECT_EQ(parse_gpu_bvh_layout(to_string(l)), l);
   try {
     parse_gpu_bvh_layout("wide16");

@@ -38,6 +38,8 @@ struct BvhHost {
   uint64_t bytes() const { return nodes.size() * sizeof(BvhNode) + tris.size() * sizeof(BvhTriangle); }
 };
 
-BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options = {});
+// `leave_out` (one flag a scene triangle, or null): the triangles flagged are not in the
+// BVH (the rects-binary layout traces them as rectangles); the others keep their scene ids.
+BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options = {}, const std::vector<char>* leave_out = nullptr);
 
 }  // namespace pb::bvh

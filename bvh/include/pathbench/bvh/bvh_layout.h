@@ -8,9 +8,14 @@
 //   rects   the scene as axis-aligned rectangles (axis_plane.h: every triangle half of
 //           one), each tested as a flat box, no triangle test (TraversalKind::Rects,
 //           its arrays in LeafListView::rects);
+//   rects-binary  the scene's largest axis-aligned rectangles (up to kRectsBinaryMaxRects:
+//           a room's walls) as rects, the other triangles in a binary BVH, the rectangles
+//           tested first (rects_binary.h, TraversalKind::RectsBinary);
 //   auto    brute at most `brute_max_triangles` triangles, else leaves up to
 //           kLeavesAutoMaxTriangles (a scene without instances) -- rects where every
-//           triangle pairs into an axis-aligned rectangle --, else kAutoLayout;
+//           triangle pairs into an axis-aligned rectangle --, else rects-binary where
+//           rectangles cover kRectsBinaryAutoCover of the scene box's surface (a scene
+//           without instances), else kAutoLayout;
 //   two-level  the instanced scene's (two_level_bvh.h): not asked for by name but by
 //           GpuBvhOptions::instancing (--instancing), on a scene with instances.
 // The choice comes from GpuBvhOptions (GpuScene's constructor: one process can A/B
@@ -33,7 +38,7 @@
 namespace pb::bvh {
 
 enum class GpuBvhLayout : uint32_t {
-  Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6, Rects = 7
+  Auto = 0, Binary = 1, Wide4 = 2, Wide8 = 3, Brute = 4, TwoLevel = 5, Leaves = 6, Rects = 7, RectsBinary = 8
 };
 
 // Measured on an H100 (results/nvidia-h100-80gb-hbm3/archive/layouts-a12fc4c, interleaved,
@@ -64,6 +69,15 @@ constexpr uint32_t kLeavesAutoMaxTriangles = 32;
 // paper-queue 15.49 -> 14.14; raw incoherent closest hits 27.6 -> 49.7 G rays/s.
 // The leaves layout tests every leaf's box for every ray: asked for by name, up to this many.
 constexpr uint32_t kLeavesMaxTriangles = 1u << 16;
+// rects-binary: the rectangles every ray tests before the binary BVH of the rest, the
+// largest by area (a room's 6 walls and its light are 7), and the share of the scene box's
+// surface they must cover for auto to take the layout: there most rays end on a rectangle,
+// and the BVH of the rest then sees a ray bounded by it (or none: a shadow ray the walls
+// block). Host counts, 200,000 random rays from inside the box (docs/notes/gpu-log.md,
+// "Walls first"): paper-cornell-ico:8 binary 9.94 nodes and 2.26 triangles a closest hit,
+// rects-binary 7 rectangles, then 4.92 nodes and 0.41 triangles.
+constexpr uint32_t kRectsBinaryMaxRects = 16;
+constexpr double kRectsBinaryAutoCover = 0.5;
 
 struct GpuBvhOptions {
   GpuBvhLayout layout = GpuBvhLayout::Auto;
@@ -90,8 +104,12 @@ struct SceneBvhHost {
   WideBvhHost wide;                // Wide4, Wide8
   std::vector<BvhTriangle> all;    // Brute: the triangles in scene order
   std::vector<LeafBox> leaves;    // Leaves: the leaves of `binary`, whose triangles it keeps (no nodes)
-  std::vector<AxisRect> rects;    // Rects: the rectangles, grouped by plane axis (rect_groups)
+  std::vector<AxisRect> rects;    // Rects, RectsBinary: the rectangles, grouped by plane axis (rect_groups)
   RectGroups rect_groups;
+  // RectsBinary: `binary` is the BVH of the triangles not in a rectangle; the rectangles'
+  // triangles follow its own in binary.tris, rect_tris of them (what --no-watertight's
+  // Moeller-Trumbore test traces instead of the rectangles).
+  uint32_t rect_tris = 0;
   TwoLevelHost two_level;          // TwoLevel
   uint32_t binary_depth = 0, binary_leaves = 0;  // the binary BVH the wide one came from
   double binary_sah = 0, build_seconds = 0;
@@ -112,6 +130,14 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options);
 // group by lower triangle id. False (and `why` says which triangle) where a triangle is
 // not half of such a rectangle.
 bool build_axis_rects(const Scene& scene, std::vector<AxisRect>& rects, RectGroups& groups, std::string* why = nullptr);
+
+// The scene's largest axis-aligned rectangles, at most `max_rects` (pairs of triangles as
+// build_axis_rects pairs them; the others are left out), grouped as build_axis_rects
+// groups them; `in_rect[i]` says whether triangle i is half of one kept. Linear in the
+// scene's triangles (pairs are found by their common box). Returns the share of the scene
+// box's surface the kept rectangles cover (0 where there are none).
+double largest_axis_rects(const Scene& scene, uint32_t max_rects, std::vector<AxisRect>& rects, RectGroups& groups,
+                          std::vector<char>& in_rect);
 
 // What a report says of --instancing for the structure `bvh` built for `scene`: asked, used,
 // why, instances and prototypes (the scene's and those built), triangles left flat, the

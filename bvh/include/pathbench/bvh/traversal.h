@@ -11,6 +11,7 @@
 #include "pathbench/bvh/binary_bvh.h"
 #include "pathbench/bvh/brute_force.h"
 #include "pathbench/bvh/leaf_list.h"
+#include "pathbench/bvh/rects_binary.h"
 #include "pathbench/bvh/two_level_bvh.h"
 #include "pathbench/bvh/wide_bvh.h"
 #include "pathbench/common/hd.h"
@@ -22,8 +23,11 @@ namespace pb::bvh {
 // two_level_bvh.h, the instanced scene's (--instancing). Leaves: leaf_list.h, the binary
 // BVH's leaves without its inner nodes (tiny scenes without instances). Rects: axis_plane.h,
 // the scene's axis-aligned rectangles (in LeafListView::rects), no triangle test.
+// RectsBinary: rects_binary.h, the largest rectangles first, then a binary BVH of the rest.
 // (5 is kBinaryExactTies below.)
-enum class TraversalKind : uint32_t { Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3, Leaves = 4, Rects = 6 };
+enum class TraversalKind : uint32_t {
+  Binary = 0, Wide = 1, AllTriangles = 2, TwoLevel = 3, Leaves = 4, Rects = 6, RectsBinary = 7
+};
 
 struct BvhView {
   BvhView() = default;
@@ -37,6 +41,7 @@ struct BvhView {
   uint32_t exact_ties = 0;            // AllTriangles: as BinaryBvhView's
   TwoLevelView two_level{};
   LeafListView leaves{};
+  RectsBinaryView rects_binary{};
 };
 
 // kKind: a TraversalKind the caller was compiled for (bvh.kind must be it), or
@@ -65,6 +70,8 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
     return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::Rects)) {  // Moeller-Trumbore asked for: the leaves it keeps
     return traverse_leaves<kAnyHit, false, 0>(bvh.leaves, o, d, t_max, t_hit, stats);
+  } else if constexpr (kKind == int(TraversalKind::RectsBinary)) {
+    return traverse_rects_binary<kAnyHit, kWatertight>(bvh.rects_binary, o, d, t_max, t_hit, stats);
   } else {
     switch (bvh.kind) {
       case TraversalKind::Wide: return traverse_wide<kAnyHit, kWatertight>(bvh.wide, o, d, t_max, t_hit, stats);
@@ -76,6 +83,8 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
       case TraversalKind::Rects:  // a triangle test (Moeller-Trumbore) asked for: the leaves the layout keeps
         if constexpr (!kWatertight) return traverse_leaves<kAnyHit, false>(bvh.leaves, o, d, t_max, t_hit, stats);
         else return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
+      case TraversalKind::RectsBinary:
+        return traverse_rects_binary<kAnyHit, kWatertight>(bvh.rects_binary, o, d, t_max, t_hit, stats);
       default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
     }
   }
@@ -103,6 +112,7 @@ decltype(auto) with_traversal_kind(const BvhView& bvh, Fn&& fn) {
     case TraversalKind::TwoLevel: return fn(std::integral_constant<int, int(TraversalKind::TwoLevel)>{});
     case TraversalKind::Leaves: return fn(std::integral_constant<int, int(TraversalKind::Leaves)>{});
     case TraversalKind::Rects: return fn(std::integral_constant<int, int(TraversalKind::Rects)>{});
+    case TraversalKind::RectsBinary: return fn(std::integral_constant<int, int(TraversalKind::RectsBinary)>{});
     default: return fn(std::integral_constant<int, int(TraversalKind::Binary)>{});
   }
 }
