@@ -248,28 +248,20 @@ GpuBvhLayout resolve_layout(const GpuBvhOptions& o, size_t triangles, size_t ins
 }
 
 namespace {
-// rects-binary (rects_binary.h), asked for by name (`asked`: a scene it cannot trace is an
-// InputError) or by auto (taken where the rectangles cover kRectsBinaryAutoCover of the
-// scene box's surface; else `out` is left as it was).
-void build_rects_binary(const Scene& scene, bool asked, SceneBvhHost& out) {
-  if (asked && !scene.instances.empty())
+// rects-binary (rects_binary.h), asked for by name: a scene it cannot trace is an InputError.
+void build_rects_binary(const Scene& scene, SceneBvhHost& out) {
+  if (!scene.instances.empty())
     throw InputError(fmt::format("GPU BVH layout rects-binary: scene '{}' has instances, whose ties it does not order "
                                  "(binary, wide4, wide8, brute or --instancing do)", scene.name));
   std::vector<char> in_rect;
-  const double cover = largest_axis_rects(scene, kRectsBinaryMaxRects, out.rects, out.rect_groups, in_rect);
+  largest_axis_rects(scene, kRectsBinaryMaxRects, out.rects, out.rect_groups, in_rect);
   const size_t walls = 2 * out.rects.size();
-  if (asked && walls == 0)
+  if (walls == 0)
     throw InputError(fmt::format("GPU BVH layout rects-binary: scene '{}' has no two triangles that make an "
                                  "axis-aligned rectangle (binary suits it)", scene.name));
-  if (asked && walls == scene.triangles.size())
+  if (walls == scene.triangles.size())
     throw InputError(fmt::format("GPU BVH layout rects-binary: every triangle of scene '{}' is half of an "
                                  "axis-aligned rectangle (rects suits it)", scene.name));
-  if (!asked && (walls == 0 || walls == scene.triangles.size() || cover < kRectsBinaryAutoCover)) {
-    out.rects.clear();
-    out.rect_groups = RectGroups{};
-    return;
-  }
-  out.layout = GpuBvhLayout::RectsBinary;
   out.binary = build_bvh(scene, BvhBuildOptions{}.with_env(), &in_rect);
   out.binary_depth = out.binary.depth;
   out.binary_leaves = out.binary.leaves;
@@ -306,10 +298,8 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
       bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
       bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
     }
-  } else if (out.layout == GpuBvhLayout::RectsBinary ||
-             (out.layout == kAutoLayout && options.layout == GpuBvhLayout::Auto && scene.instances.empty() &&
-              scene.triangles.size() > kLeavesAutoMaxTriangles)) {
-    build_rects_binary(scene, options.layout == GpuBvhLayout::RectsBinary, out);
+  } else if (out.layout == GpuBvhLayout::RectsBinary) {
+    build_rects_binary(scene, out);
   }
   if (out.layout != GpuBvhLayout::TwoLevel && out.layout != GpuBvhLayout::Brute &&
       out.layout != GpuBvhLayout::RectsBinary) {

@@ -88,13 +88,13 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
 }
 
 // The counts k_pixel is compiled for (float, watertight): 3 and kPixelLatencyBlocks for every
-// layout, 5 too for the wide, leaves, rects, binary and rects-binary layouts (kWideLatencyBlocks,
+// layout, 5 too for the wide, leaves, rects and binary layouts (kWideLatencyBlocks,
 // kLeavesParkedBlocks, the binary BVH's opt-in); the parked path state for the leaves layout
 // at every count but kPixelLatencyBlocks and the binary BVH's at 5 and 8. run_pixel
 // dispatches on these, pixel_blocks and pixel_occupancy choose within them.
 constexpr bool compiled_for_five_blocks(int kind) {
   return kind == int(TraversalKind::Wide) || kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Binary) ||
-         kind == int(TraversalKind::Rects) || kind == int(TraversalKind::RectsBinary);
+         kind == int(TraversalKind::Rects);
 }
 constexpr bool parked_compiled(int kind, int blocks) {
   return ((kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Rects)) && blocks != kPixelLatencyBlocks) ||
@@ -114,7 +114,7 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
                     (compiled_for_five_blocks(int(g.bvh.kind)) && v == "5");
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
-                                   "auto, 3, 5 or 8; the leaves, rects, binary and rects-binary layouts: also 5)", v,
+                                   "auto, 3, 5 or 8; the leaves, rects and binary layouts: also 5)", v,
                                    kPixelLatencyBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }

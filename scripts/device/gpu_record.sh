@@ -7,15 +7,17 @@
 # left. Everything goes to OUT_DIR; console output says what passed.
 #   scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]
 # BASE_PATCH: `git diff BASE -- gpu/ bvh/ common/` made on the development host, or a whole base
-# tree `git archive BASE | xz > base.tar.xz` (where the change moved files); CASES_FILE: the
+# tree `git archive BASE | xz > base.tar.xz` (where the change moved files), or `none`: no base
+# build and no A/B (the call's time goes to the roofline, which needs ~2 minutes); CASES_FILE: the
 # A/B's cases (scripts/device/gpu_ab.sh's format), else its defaults. Needs .gpu-deps (see
 # ../shared/gpu-host/README.md); PATHBENCH_SOURCE_COMMIT names the commit in the reports
 # (from .gpu-deps/source-commit when set there).
 set -uo pipefail
 out=${1:?usage: scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}
-patch_file=$(realpath "${2:?usage: scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}")
+patch_file=${2:?usage: scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]}
+[ "$patch_file" = none ] || patch_file=$(realpath "$patch_file")
 cases=${3:+$(realpath "$3")}
-for f in "$patch_file" ${cases:+"$cases"}; do  # before anything is made
+for f in ${patch_file/#none/} ${cases:+"$cases"}; do  # before anything is made
   if [ ! -f "$f" ] || [ ! -r "$f" ]; then echo "gpu_record.sh: $f: not a readable file" >&2; exit 2; fi
 done
 mkdir -p "$out"
@@ -33,13 +35,15 @@ nvidia-smi --query-gpu=name,driver_version,temperature.gpu,clocks.sm,clocks.max.
   --format=csv > "$out/gpu-state-start.csv" 2>&1
 base=/tmp/pathbench-base
 rm -rf $base && mkdir -p $base
-if [[ $patch_file == *.tar.xz ]]; then  # a whole base tree (`git archive BASE | xz`): where files moved
+if [ "$patch_file" = none ]; then
+  echo "no base: no A/B"
+elif [[ $patch_file == *.tar.xz ]]; then  # a whole base tree (`git archive BASE | xz`): where files moved
   tar -xJf "$patch_file" -C $base || { echo "the base tree $patch_file does not unpack"; exit 1; }
 else
   tar --exclude=./build-gpu --exclude=./build --exclude=./.git -cf - . | tar -xf - -C $base
   (cd $base && patch -s -R -p1 < "$patch_file") || { echo "the base patch does not reverse on this tree"; exit 1; }
 fi
-(cmake -S $base -B $base/build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF \
+[ "$patch_file" = none ] || (cmake -S $base -B $base/build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DPATHBENCH_CUDA=ON -DPATHBENCH_OIIO=OFF \
    -DCMAKE_CUDA_ARCHITECTURES=90 > /dev/null 2>&1 && cmake --build $base/build-gpu -j 5 --target pathbench pathbench-bench \
    > "$out/base-build.log" 2>&1; echo "base build rc=$?") &
 OUT=$out bash scripts/device/run_on_device.sh build test sanitize > "$out/run_on_device.txt" 2>&1
@@ -76,9 +80,11 @@ for name in ["bench-paper-gpu.json", "bench-raycast-gpu.json"]:
             extra = f" {b['rays_per_second']/1e9:.2f} Grays/s" if "rays_per_second" in b else ""
             print(f"{b['run_name'][:70]:70s} {b['real_time']:.3f} {b['time_unit']}{extra}")
 PY
-NO_RAYCAST=${NO_RAYCAST:-} CASES=$cases bash scripts/device/gpu_ab.sh $base/build-gpu build-gpu "$out/ab" 3 > "$out/ab-summary.txt" 2>&1
-echo "ab rc=$?"; cat "$out/ab-summary.txt"
-rm -rf "$out/ab/films"
+if [ "$patch_file" != none ]; then
+  NO_RAYCAST=${NO_RAYCAST:-} CASES=$cases bash scripts/device/gpu_ab.sh $base/build-gpu build-gpu "$out/ab" 3 > "$out/ab-summary.txt" 2>&1
+  echo "ab rc=$?"; cat "$out/ab-summary.txt"
+  rm -rf "$out/ab/films"
+fi
 if [ $SECONDS -lt 420 ]; then
   LAUNCHES=60 bash scripts/device/gpu_roofline.sh build-gpu "$out/roofline" > "$out/roofline.txt" 2>&1
   echo "roofline rc=$? at ${SECONDS}s"

@@ -346,7 +346,7 @@ TEST(RectsLayout, AutoPicksRectsWhereEveryTriangleIsHalfARectangle) {
   EXPECT_EQ(r.nodes(), 7u);
   EXPECT_EQ(r.view().kind, TraversalKind::Rects);
   const Scene ico = load_scene("paper-cornell-ico:0");
-  EXPECT_EQ(build_scene_bvh(ico, GpuBvhOptions{}).layout, GpuBvhLayout::RectsBinary);  // 34 triangles: past the leaves' 32
+  EXPECT_EQ(build_scene_bvh(ico, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);  // 34 triangles: past the leaves' 32
   GpuBvhOptions o;
   o.layout = GpuBvhLayout::Rects;
   try {
@@ -471,14 +471,16 @@ TEST(RectsLayout, MoellerTrumboreTracesTheLeaves) {
   EXPECT_EQ(differ, 0u);
 }
 
-// rects-binary (rects_binary.h): auto takes it where the largest axis-aligned rectangles
-// cover half the scene box's surface (a room's walls around meshes), and the rectangles
-// are the walls and the light; the BVH holds the rest under their scene ids, and the
-// rectangles' triangles follow them for Moeller-Trumbore.
-TEST(RectsBinaryLayout, AutoTakesTheWallsOfARoom) {
+// rects-binary (rects_binary.h), by name: the rectangles are a room's walls and light; the
+// BVH holds the rest under their scene ids, and the rectangles' triangles follow them for
+// Moeller-Trumbore. auto does not take it (measured: bvh_layout.h).
+TEST(RectsBinaryLayout, TheWallsOfARoom) {
+  GpuBvhOptions by_name;
+  by_name.layout = GpuBvhLayout::RectsBinary;
   for (const char* name : {"paper-cornell-ico:0", "paper-cornell-ico:3"}) {
     const Scene s = load_scene(name);
-    const SceneBvhHost b = build_scene_bvh(s, GpuBvhOptions{});
+    EXPECT_EQ(build_scene_bvh(s, GpuBvhOptions{}).layout, GpuBvhLayout::Binary) << name;
+    const SceneBvhHost b = build_scene_bvh(s, by_name);
     ASSERT_EQ(b.layout, GpuBvhLayout::RectsBinary) << name;
     EXPECT_EQ(b.rects.size(), 7u) << name;  // 6 walls and the light
     EXPECT_EQ(b.rect_tris, 14u) << name;
@@ -492,14 +494,6 @@ TEST(RectsBinaryLayout, AutoTakesTheWallsOfARoom) {
     for (size_t i = 0; i < s.triangles.size(); ++i)
       EXPECT_EQ(int(seen[i]), i < 14 ? 10 : 1) << name << ": triangle " << i;  // the box's 14 come first
   }
-  // Not a room: the Cornell box's measured walls are not exactly axis-aligned, and the few
-  // rectangles it has cover under half its box's surface.
-  const Scene cornell = load_scene("cornell-box");
-  std::vector<AxisRect> rects;
-  RectGroups groups;
-  std::vector<char> in_rect;
-  EXPECT_LT(largest_axis_rects(cornell, kRectsBinaryMaxRects, rects, groups, in_rect), kRectsBinaryAutoCover);
-  EXPECT_EQ(build_scene_bvh(cornell, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);
   EXPECT_EQ(parse_gpu_bvh_layout("rects-binary"), GpuBvhLayout::RectsBinary);
 }
 
@@ -524,7 +518,6 @@ TEST(RectsBinaryLayout, RefusesWhatItCannotTrace) {
       EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
     }
   }
-  EXPECT_EQ(build_scene_bvh(inst, GpuBvhOptions{}).layout, GpuBvhLayout::Binary);  // auto: not with instances
 }
 
 // The largest rectangles, at most the limit asked for; of equal areas the lower ids; the
@@ -567,9 +560,10 @@ TEST(RectsBinaryLayout, KeepsTheLargestRectangles) {
 // that test, so its answers are the binary BVH's with Moeller-Trumbore over every triangle.
 TEST(RectsBinaryLayout, MoellerTrumboreTestsTheWallsTriangles) {
   const Scene s = load_scene("paper-cornell-ico:2");
-  GpuBvhOptions o;
+  GpuBvhOptions o, by_name;
   o.layout = GpuBvhLayout::Binary;
-  const SceneBvhHost walls = build_scene_bvh(s, GpuBvhOptions{}), binary = build_scene_bvh(s, o);
+  by_name.layout = GpuBvhLayout::RectsBinary;
+  const SceneBvhHost walls = build_scene_bvh(s, by_name), binary = build_scene_bvh(s, o);
   ASSERT_EQ(walls.layout, GpuBvhLayout::RectsBinary);
   const Vec3f ext = s.bounds_max - s.bounds_min;
   const auto rays = test::random_rays(s.bounds_min + ext * 0.02f, s.bounds_max - ext * 0.02f, 5000, 31);

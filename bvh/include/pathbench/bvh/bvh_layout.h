@@ -13,9 +13,8 @@
 //           tested first (rects_binary.h, TraversalKind::RectsBinary);
 //   auto    brute at most `brute_max_triangles` triangles, else leaves up to
 //           kLeavesAutoMaxTriangles (a scene without instances) -- rects where every
-//           triangle pairs into an axis-aligned rectangle --, else rects-binary where
-//           rectangles cover kRectsBinaryAutoCover of the scene box's surface (a scene
-//           without instances), else kAutoLayout;
+//           triangle pairs into an axis-aligned rectangle --, else kAutoLayout (rects-binary
+//           only by name: measured, below);
 //   two-level  the instanced scene's (two_level_bvh.h): not asked for by name but by
 //           GpuBvhOptions::instancing (--instancing), on a scene with instances.
 // The choice comes from GpuBvhOptions (GpuScene's constructor: one process can A/B
@@ -70,14 +69,15 @@ constexpr uint32_t kLeavesAutoMaxTriangles = 32;
 // The leaves layout tests every leaf's box for every ray: asked for by name, up to this many.
 constexpr uint32_t kLeavesMaxTriangles = 1u << 16;
 // rects-binary: the rectangles every ray tests before the binary BVH of the rest, the
-// largest by area (a room's 6 walls and its light are 7), and the share of the scene box's
-// surface they must cover for auto to take the layout: there most rays end on a rectangle,
-// and the BVH of the rest then sees a ray bounded by it (or none: a shadow ray the walls
-// block). Host counts, 200,000 random rays from inside the box (docs/notes/gpu-log.md,
-// "Walls first"): paper-cornell-ico:8 binary 9.94 nodes and 2.26 triangles a closest hit,
-// rects-binary 7 rectangles, then 4.92 nodes and 0.41 triangles.
+// largest by area (a room's 6 walls and its light are 7). Host counts, 200,000 random rays
+// from inside the box: paper-cornell-ico:8 binary 9.94 nodes and 2.26 triangles a closest
+// hit, rects-binary 7 rectangles, then 4.92 nodes and 0.41 triangles. Measured on an H100
+// (docs/notes/gpu-log.md, "Walls first"; 256x256x800 nee, interleaved against binary), it
+// pays only where traversal is memory bound: the wavefront's ico:8 51.38 -> 46.26 ms (0.90),
+// while the megakernel, whose warps wait for their slowest lane's traversal, does not gain
+// (ico:8 40.48 -> 40.57 ms, bunny-armadillo 41.58 -> 42.33, glass-dragon 195.1 -> 200.8,
+// large-mesh 52.96 -> 54.15, ico:3 25.80 -> 29.79). So auto does not take it.
 constexpr uint32_t kRectsBinaryMaxRects = 16;
-constexpr double kRectsBinaryAutoCover = 0.5;
 
 struct GpuBvhOptions {
   GpuBvhLayout layout = GpuBvhLayout::Auto;
