@@ -79,8 +79,16 @@ __device__ __forceinline__ PathState<float> current_path(const SceneView& s, con
 // Blocks an SM for the trace kernel: 5 (48 registers) suits the binary and brute-force
 // traversals; the wide one holds a node's 20 words and spills under 48 (ptxas, when
 // closest hits and shadow rays were two kernels: 28 B and 100 B), so it gets 4 (64 registers).
+// -DPB_WF_TRACE_BLOCKS=N and -DPB_WF_SHADE_BLOCKS=N build other counts (measurements).
+#ifndef PB_WF_TRACE_BLOCKS
+#define PB_WF_TRACE_BLOCKS 5
+#endif
+#ifndef PB_WF_SHADE_BLOCKS
+#define PB_WF_SHADE_BLOCKS 3
+#endif
 template <int kKind>
-constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : 5;
+constexpr int kTraversalBlocksPerSm = kKind == int(TraversalKind::Wide) ? 4 : PB_WF_TRACE_BLOCKS;
+constexpr int kShadeBlocksPerSm = PB_WF_SHADE_BLOCKS;
 
 // One chunk of the shadow rays the last shade queued (n of them; rays [base, base + 32)):
 // occlusion, then the radiance to the film (a path that ended) or to the continuing path's
@@ -242,7 +250,7 @@ __device__ __forceinline__ void shade_chunk(const SceneView& s, const PathConfig
 }
 
 template <bool kVariance, uint32_t Kinds>
-__global__ void __launch_bounds__(256, 3) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
+__global__ void __launch_bounds__(256, kShadeBlocksPerSm) k_wf_shade(SceneView s, PathConfig c, PathSoA cur, PathSoA next,
                                                      const uint32_t* prim, ShadowSoA sh, WaveCounters* ctr, uint32_t parity,
                                                      FilmDev film, uint32_t counter_rounds) {
   kernel_prologue();
