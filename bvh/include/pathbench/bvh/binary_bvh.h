@@ -59,14 +59,6 @@ PB_HD void load_node(const BvhNode* nodes, uint32_t i, float (&x)[4], float (&y)
 // leaf(first, count) tests a leaf's items and returns true to end the walk (an any-hit
 // query's hit); then walk_binary returns true. Shared by the flat traversal below and
 // both levels of the two-level one (two_level_bvh.h).
-// -DPB_SPECULATIVE_TRAVERSAL=1 (device code; a measurement): a lane that reaches a leaf while
-// others of its warp still walk inner nodes holds it and walks on until every lane holds one
-// (Aila & Laine, HPG 2009, "speculative traversal"), then all test their leaves together.
-// The leaves' order then depends on the warp, so ties need the least-(t, id) rule.
-#ifndef PB_SPECULATIVE_TRAVERSAL
-#define PB_SPECULATIVE_TRAVERSAL 0
-#endif
-
 template <class Leaf>
 PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, const float& t, Leaf&& leaf,
                        TraversalStats* stats) {
@@ -74,45 +66,6 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
   uint32_t stack[kTraversalStackSize];
   int sp = 0;
   uint32_t ref = 0;
-#if defined(__CUDA_ARCH__) && PB_SPECULATIVE_TRAVERSAL
-  constexpr uint32_t kEnd = 0xFFFFFFFFu;  // a "leaf" no scene has: the walk is over
-  uint32_t held = 0;                      // a held leaf (0, the root, is never one)
-  for (;;) {
-    while (!is_leaf(ref)) {
-      float x[4], y[4], z[4];
-      uint32_t child[2];
-      load_node(nodes, ref, x, y, z, child);
-      float tn[2], tf[2];
-      for (int c = 0; c < 2; ++c)
-        slab_interval(x[2 * c], x[2 * c + 1], y[2 * c], y[2 * c + 1], z[2 * c], z[2 * c + 1], sr, t, tn[c], tf[c]);
-      const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
-      if (h0 && h1) {
-        const bool swap = tn[1] < tn[0];
-        ref = swap ? child[1] : child[0];
-        stack[sp++] = swap ? child[0] : child[1];
-      } else if (h0 || h1) {
-        ref = h0 ? child[0] : child[1];
-      } else {
-        ref = sp == 0 ? kEnd : stack[--sp];
-      }
-      if (is_leaf(ref) && ref != kEnd && held == 0) {
-        held = ref;
-        ref = sp == 0 ? kEnd : stack[--sp];
-      }
-      if (!__any_sync(__activemask(), held == 0)) break;
-    }
-    if (held != 0) {
-      if (leaf(leaf_first(held), leaf_count(held))) return true;
-      held = 0;
-    }
-    if (ref == kEnd) return false;
-    if (is_leaf(ref)) {
-      if (leaf(leaf_first(ref), leaf_count(ref))) return true;
-      if (sp == 0) return false;
-      ref = stack[--sp];
-    }
-  }
-#else
   for (;;) {
     while (!is_leaf(ref)) {
       float x[4], y[4], z[4];
@@ -138,7 +91,6 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
     if (sp == 0) return false;
     ref = stack[--sp];
   }
-#endif
 }
 
 }  // namespace detail

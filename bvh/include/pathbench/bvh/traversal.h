@@ -49,11 +49,6 @@ struct BvhView {
 // instances traced flat (exact_ties set), compiled apart from Binary (exact_ties unset)
 // so that flat scenes' kernels carry no tie compare (binary_bvh.h's traverse, kExact).
 constexpr int kAnyKind = -1;
-// -DPB_FLAT_EXACT_TIES=1 (a measurement): the binary kernels of scenes without instances keep
-// the least (t, id) too, as binary_bvh.h's speculative traversal needs.
-#ifndef PB_FLAT_EXACT_TIES
-#define PB_FLAT_EXACT_TIES 0
-#endif
 constexpr int kBinaryExactTies = 5;
 
 template <bool kAnyHit, bool kWatertight = true, int kKind = kAnyKind>
@@ -64,7 +59,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
   } else if constexpr (kKind == int(TraversalKind::AllTriangles)) {
     return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
   } else if constexpr (kKind == int(TraversalKind::Binary)) {
-    return traverse<kAnyHit, kWatertight, PB_FLAT_EXACT_TIES>(bvh.binary, o, d, t_max, t_hit, stats);
+    return traverse<kAnyHit, kWatertight, 0>(bvh.binary, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == kBinaryExactTies) {
     return traverse<kAnyHit, kWatertight, 1>(bvh.binary, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::TwoLevel)) {
