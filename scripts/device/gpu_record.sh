@@ -8,8 +8,7 @@
 #   scripts/device/gpu_record.sh OUT_DIR BASE_PATCH [CASES_FILE]
 # BASE_PATCH: `git diff BASE -- gpu/ bvh/ common/` made on the development host, or a whole base
 # tree `git archive BASE | xz > base.tar.xz` (where the change moved files), or `none`: no base
-# build and no A/B (the call's time goes to the roofline, which needs ~2 minutes); CASES_FILE: the
-# A/B's cases (scripts/device/gpu_ab.sh's format), else its defaults. Needs .gpu-deps (see
+# build and no A/B; CASES_FILE: the A/B's cases (scripts/device/gpu_ab.sh's format), else its defaults. Needs .gpu-deps (see
 # ../shared/gpu-host/README.md); PATHBENCH_SOURCE_COMMIT names the commit in the reports
 # (from .gpu-deps/source-commit when set there).
 set -uo pipefail
@@ -85,7 +84,8 @@ if [ "$patch_file" != none ]; then
   echo "ab rc=$?"; cat "$out/ab-summary.txt"
   rm -rf "$out/ab/films"
 fi
-if [ $SECONDS -lt 420 ]; then
+# The roofline took 30 s on an H100 at 90a862f; ROOFLINE_BEFORE_S: start it only before this.
+if [ $SECONDS -lt "${ROOFLINE_BEFORE_S:-480}" ]; then
   LAUNCHES=60 bash scripts/device/gpu_roofline.sh build-gpu "$out/roofline" > "$out/roofline.txt" 2>&1
   echo "roofline rc=$? at ${SECONDS}s"
 else
