@@ -109,13 +109,7 @@ class Flattener {
       if (first + count > kLeafFirstMask) throw std::runtime_error("bvh: too many triangle references for the GPU layout");
       for (uint32_t i = 0; i < count; ++i) {
         const uint32_t p = prims[i];
-        const Triangle& t = s_.triangles[p];
-        BvhTriangle bt{};
-        const Vec3f a = s_.positions[t.v[0]], b = s_.positions[t.v[1]], c = s_.positions[t.v[2]];
-        bt.v0[0] = a.x; bt.v0[1] = a.y; bt.v0[2] = a.z; bt.prim = p;
-        bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
-        bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
-        out_.tris.push_back(bt);
+        out_.tris.push_back(bvh_triangle(s_, p));
         const Box tb = tri_box(p);
         box.grow(tb.lo);
         box.grow(tb.hi);
@@ -229,16 +223,28 @@ BvhBuildOptions BvhBuildOptions::with_env() const {
   return o;
 }
 
+BvhTriangle bvh_triangle(const Scene& scene, uint32_t id) {
+  const Triangle& t = scene.triangles[id];
+  const Vec3f a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
+  BvhTriangle bt{};
+  bt.v0[0] = a.x; bt.v0[1] = a.y; bt.v0[2] = a.z; bt.prim = id;
+  bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
+  bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
+  return bt;
+}
+
 BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options, const std::vector<char>* leave_out) {
   if (options.max_leaf_size < 1 || options.max_leaf_size > kMaxLeafPrims)
     throw std::invalid_argument(fmt::format("bvh: max_leaf_size must be 1..{}", kMaxLeafPrims));
   const auto t0 = std::chrono::steady_clock::now();
   BvhHost out;
-  std::vector<uint32_t> ids;  // the scene triangles in the BVH
-  ids.reserve(scene.triangles.size());
-  for (uint32_t i = 0; i < scene.triangles.size(); ++i)
-    if (!leave_out || !(*leave_out)[i]) ids.push_back(i);
-  const size_t n = ids.size();
+  // The scene triangles in the BVH: all of them (ids left empty), or those not left out.
+  std::vector<uint32_t> ids;
+  if (leave_out)
+    for (uint32_t i = 0; i < scene.triangles.size(); ++i)
+      if (!(*leave_out)[i]) ids.push_back(i);
+  const size_t n = leave_out ? ids.size() : scene.triangles.size();
+  auto id_of = [&](size_t i) { return leave_out ? ids[i] : uint32_t(i); };
 
   // Pad boxes by a few ulps of the scene's largest coordinate: the slab test's
   // rounding (fused or not) then never culls a box a ray really touches.
@@ -265,10 +271,10 @@ BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options, const std:
   std::vector<RTCBuildPrimitive> prims(capacity);
   for (size_t i = 0; i < n; ++i) {
     Box b;
-    for (int k = 0; k < 3; ++k) b.grow(scene.positions[scene.triangles[ids[i]].v[k]]);
+    for (int k = 0; k < 3; ++k) b.grow(scene.positions[scene.triangles[id_of(i)].v[k]]);
     RTCBuildPrimitive& p = prims[i];
     p.lower_x = b.lo.x; p.lower_y = b.lo.y; p.lower_z = b.lo.z; p.geomID = 0;
-    p.upper_x = b.hi.x; p.upper_y = b.hi.y; p.upper_z = b.hi.z; p.primID = ids[i];
+    p.upper_x = b.hi.x; p.upper_y = b.hi.y; p.upper_z = b.hi.z; p.primID = unsigned(id_of(i));
   }
 
   RTCBuildArguments args = rtcDefaultBuildArguments();

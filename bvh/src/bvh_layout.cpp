@@ -105,15 +105,7 @@ void build_rects_binary(const Scene& scene, SceneBvhHost& out) {
   out.binary_sah = out.binary.sah_cost;
   // The rectangles' triangles after the BVH's, for Moeller-Trumbore (rects_binary.h).
   for (const AxisRect& r : out.rects)
-    for (uint32_t id : {r.key, r.other & kRectIdMask}) {
-      const Triangle& t = scene.triangles[id];
-      const Vec3f a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
-      BvhTriangle bt{};
-      bt.v0[0] = a.x; bt.v0[1] = a.y; bt.v0[2] = a.z; bt.prim = id;
-      bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
-      bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
-      out.binary.tris.push_back(bt);
-    }
+    for (uint32_t id : {r.key, r.other & kRectIdMask}) out.binary.tris.push_back(bvh_triangle(scene, id));
   out.rect_tris = uint32_t(walls);
 }
 }  // namespace
@@ -125,16 +117,8 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
   if (out.layout == GpuBvhLayout::TwoLevel) {
     out.two_level = build_two_level_bvh(scene);
   } else if (out.layout == GpuBvhLayout::Brute) {
-    out.all.resize(scene.triangles.size());
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
-      const Triangle& t = scene.triangles[i];
-      const Vec3f a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
-      BvhTriangle& bt = out.all[i];
-      bt = BvhTriangle{};
-      bt.v0[0] = a.x; bt.v0[1] = a.y; bt.v0[2] = a.z; bt.prim = uint32_t(i);
-      bt.v1[0] = b.x; bt.v1[1] = b.y; bt.v1[2] = b.z;
-      bt.v2[0] = c.x; bt.v2[1] = c.y; bt.v2[2] = c.z;
-    }
+    out.all.reserve(scene.triangles.size());
+    for (uint32_t i = 0; i < scene.triangles.size(); ++i) out.all.push_back(bvh_triangle(scene, i));
   } else if (out.layout == GpuBvhLayout::RectsBinary) {
     build_rects_binary(scene, out);
   }

@@ -38,6 +38,9 @@ struct BvhHost {
   uint64_t bytes() const { return nodes.size() * sizeof(BvhNode) + tris.size() * sizeof(BvhTriangle); }
 };
 
+// Scene triangle `id` as the traversals' 48-byte record (its vertices and id).
+BvhTriangle bvh_triangle(const Scene& scene, uint32_t id);
+
 // `leave_out` (one flag a scene triangle, or null): the triangles flagged are not in the
 // BVH (the rects-binary layout traces them as rectangles); the others keep their scene ids.
 BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options = {}, const std::vector<char>* leave_out = nullptr);
