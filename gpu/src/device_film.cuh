@@ -130,6 +130,80 @@ __device__ __forceinline__ void film_add_warp(const FilmDev& film, bool add, uin
 }
 
 
+// One lane's running sum of the samples it ends, for one pixel at a time (the refill
+// megakernel, pixel_refill.cu, whose lanes end their paths at different times and so
+// cannot meet in film_add_warp): the same integer sums, added to the film by atomics when
+// the lane moves to another pixel and at its end. Integer sums do not depend on their
+// order, so the film is film_add_warp's bit for bit (the variance's double sums are as
+// order-dependent as film_add_warp's atomics).
+template <bool kVariance> struct LaneFilmSum {
+  uint32_t pixel = kNoPixel;
+  long long q0 = 0, q1 = 0, q2 = 0;
+  uint32_t count = 0;
+  double s0 = 0, s1 = 0, s2 = 0;
+
+  __device__ void add(const FilmDev& film, uint32_t px, const Vec3f& L, unsigned long long* discarded) {
+    if (!sample_acceptable(L, film.limit)) {
+      atomicAdd(discarded, 1ull);
+      return;
+    }
+    if (px != pixel) {
+      flush(film);
+      pixel = px;
+    }
+    q0 += quantize_radiance(L.x, film.scale);
+    q1 += quantize_radiance(L.y, film.scale);
+    q2 += quantize_radiance(L.z, film.scale);
+    ++count;
+    if (kVariance) {
+      s0 += double(L.x) * double(L.x);
+      s1 += double(L.y) * double(L.y);
+      s2 += double(L.z) * double(L.z);
+    }
+  }
+  __device__ void flush(const FilmDev& film) {
+    if (count != 0) {
+      unsigned long long* sum = film.sum + size_t(pixel) * 3;
+      atomicAdd(sum + 0, static_cast<unsigned long long>(q0));
+      atomicAdd(sum + 1, static_cast<unsigned long long>(q1));
+      atomicAdd(sum + 2, static_cast<unsigned long long>(q2));
+      atomicAdd(film.count + pixel, count);
+      if (kVariance) {
+        double* sq = film.sum_sq + size_t(pixel) * 3;
+        atomicAdd(sq + 0, s0);
+        atomicAdd(sq + 1, s1);
+        atomicAdd(sq + 2, s2);
+      }
+    }
+    q0 = q1 = q2 = 0;
+    count = 0;
+    s0 = s1 = s2 = 0;
+  }
+};
+
+// The block's ray and path counts (the pixel megakernels' Stats), one atomic per counter per block.
+__device__ __forceinline__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths) {
+  __shared__ unsigned long long acc[3];
+  if (threadIdx.x < 3) acc[threadIdx.x] = 0;
+  __syncthreads();
+  bounce = __reduce_add_sync(kFullMask, bounce);
+  shadow = __reduce_add_sync(kFullMask, shadow);
+  paths = __reduce_add_sync(kFullMask, paths);
+  if ((threadIdx.x & 31) == 0) {
+    atomicAdd(&acc[0], bounce);
+    atomicAdd(&acc[1], shadow);
+    atomicAdd(&acc[2], paths);
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    atomicAdd(&stats->bounce, acc[0]);
+    atomicAdd(&stats->shadow, acc[1]);
+    atomicAdd(&stats->paths, acc[2]);
+    atomicAdd(&stats->camera, acc[2]);
+  }
+}
+
+
 struct FilmBuffers {
   DeviceBuffer<unsigned long long> sum;
   DeviceBuffer<uint32_t> count;
