@@ -11,7 +11,6 @@
 #include "device_film.cuh"
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
-#include "parked_path.cuh"
 #include "path_step.cuh"
 #include "pathbench/bvh/traversal.h"
 #include "pathbench/common/errors.h"
@@ -23,12 +22,42 @@ namespace pb::gpu {
 
 namespace {
 
+// The block's ray and path counts, one atomic per counter per block. (Discarded samples
+// are counted where they are rejected, in film_add_warp.)
+__device__ void block_stats_add(Stats* stats, uint32_t bounce, uint32_t shadow, uint32_t paths) {
+  __shared__ unsigned long long acc[3];
+  if (threadIdx.x < 3) acc[threadIdx.x] = 0;
+  __syncthreads();
+  bounce = __reduce_add_sync(kFullMask, bounce);
+  shadow = __reduce_add_sync(kFullMask, shadow);
+  paths = __reduce_add_sync(kFullMask, paths);
+  if ((threadIdx.x & 31) == 0) {
+    atomicAdd(&acc[0], bounce);
+    atomicAdd(&acc[1], shadow);
+    atomicAdd(&acc[2], paths);
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    atomicAdd(&stats->bounce, acc[0]);
+    atomicAdd(&stats->shadow, acc[1]);
+    atomicAdd(&stats->paths, acc[2]);
+    atomicAdd(&stats->camera, acc[2]);
+  }
+}
+
 // kMinBlocks: blocks of 256 an SM must fit, registers capped to match (1: the compiler's
 // choice, 91 registers and 2 blocks for the float watertight kernel). Measured on an H100
 // (docs/notes/gpu-log.md, "Occupancy of the megakernel"): 3 blocks suit scenes whose BVH sits in
 // L1 (issue bound), kPixelLatencyBlocks (8: 32 registers, spills) scenes that miss to L2
 // (latency bound).
-// kParked: the path state parked in shared memory (parked_path.cuh).
+// kParked: each thread's path state and shadow query live in the block's shared memory
+// (25 words a thread, an odd stride: no bank conflicts) instead of registers, so that the
+// traversals, where the register peak is, run with ~25 registers fewer live.
+template <class T> struct ParkedPath {
+  PathState<T> st;
+  ShadowQuery<T> q;
+};
+static_assert(sizeof(ParkedPath<float>) == 100, "25 words: an odd stride in words");
 
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks, bool kParked = false>
 __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint64_t total,
@@ -94,29 +123,6 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
                                  kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
-// PATHBENCH_GPU_PIXEL_REFILL=auto|0|1 and _REFILL_MIN (PixelOccupancy::refill): the refill
-// megakernel runs the binary BVH without instances, at 5 or kPixelLatencyBlocks blocks.
-void pixel_refill_choice(const GpuScene::Impl& g, PixelOccupancy& o) {
-  const char* env = std::getenv("PATHBENCH_GPU_PIXEL_REFILL");
-  const std::string v = env ? env : "auto";
-  if (v != "auto" && v != "0" && v != "1")
-    throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_REFILL={}: expected auto, 0 or 1", v));
-  const char* m = std::getenv("PATHBENCH_GPU_PIXEL_REFILL_MIN");
-  if (m) {
-    const std::string mv = m;
-    const bool digits = !mv.empty() && mv.size() <= 2 && mv.find_first_not_of("0123456789") == std::string::npos;
-    const int n = digits ? std::stoi(mv) : 0;
-    if (n < 1 || n > 32)
-      throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_REFILL_MIN={}: expected a lane count from 1 to 32", mv));
-    o.refill_min_active = uint32_t(n);
-  }
-  const bool binary = g.bvh.kind == TraversalKind::Binary && !g.bvh.binary.exact_ties;
-  o.refill = binary && v == "1";
-  if (!o.refill) return;
-  if (o.min_blocks != 5 && o.min_blocks != kPixelLatencyBlocks) o.min_blocks = 5;  // its compiled counts
-  o.why += fmt::format("; refill megakernel (finished lanes shade when fewer than {} walk)", o.refill_min_active);
-}
-
 }  // namespace
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
@@ -128,7 +134,6 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   else if (v == "0" || v == "1") o.parked = v == "1";
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
   if (o.parked && !parked_compiled(int(g.bvh.kind), o.min_blocks)) o.parked = false;
-  pixel_refill_choice(g, o);
   const char* blocks = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
     o.min_blocks = kLeavesParkedBlocks;
@@ -141,12 +146,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
 
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<PixelCounters>& counters, const PixelOccupancy& occupancy) {
-  const int min_blocks = occupancy.min_blocks;
-  const bool parked = occupancy.parked;
-  if (occupancy.refill && precision == Precision::Float && watertight)
-    return run_pixel_refill(launch, stream, g, c, total, film, variance, counters, min_blocks, parked,
-                            occupancy.refill_min_active);
+                      DeviceBuffer<PixelCounters>& counters, int min_blocks, bool parked) {
   PB_CUDA_CHECK(cudaMemsetAsync(counters.get(), 0, sizeof(PixelCounters), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
   // In float with the watertight test, compiled for the scene's BVH layout and the

@@ -248,7 +248,7 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
 FrameResult RenderSetup::run_frame(uint64_t n, bool variance) {
   if (settings.strategy == Strategy::Pixel)
     return run_pixel(launch, stream, g, config, n, fb.view, variance, settings.precision, settings.watertight,
-                     pixel_counters, occupancy);
+                     pixel_counters, occupancy.min_blocks, occupancy.parked);
   return run_pools(pool_ptrs.data(), pool_stream_ids.data(), int(pool_ptrs.size()), launch, g, config, n, fb.view,
                    variance);
 }
@@ -372,9 +372,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
     x["pixel_block"] = su.launch.block_size("pixel");
     if (settings.precision == Precision::Float && settings.watertight)
       x["pixel_occupancy"] = {{"min_blocks_per_sm", su.occupancy.min_blocks}, {"why", su.occupancy.why},
-                              {"parked_path_state", su.occupancy.parked},
-                              {"refill", su.occupancy.refill}};
-      if (su.occupancy.refill) x["pixel_occupancy"]["refill_min_active"] = su.occupancy.refill_min_active;
+                              {"parked_path_state", su.occupancy.parked}};
   }
   if (profile) {
     const nlohmann::json prof = su.launch.collect();

@@ -36,9 +36,6 @@ struct ShadowUse {
   }
 };
 
-// The refill megakernel's default threshold (PixelOccupancy::refill_min_active).
-constexpr uint32_t kRefillMinActive = 16;
-
 // The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
 // and the megakernel waits on memory (more warps hide it); below, it is issue bound.
@@ -53,12 +50,6 @@ struct PixelOccupancy {
   // and 8 blocks (paper-cornell-ico:8 at 8: 40.53 -> 39.93 ms; not yet the default: the
   // other latency-bound scenes, whose L1 it shrinks, are not measured).
   bool parked = false;
-  // The refill megakernel (pixel_refill.cu) instead of k_pixel: the binary BVH (no instances)
-  // at 5 or 8 blocks, float and watertight. PATHBENCH_GPU_PIXEL_REFILL=auto|0|1;
-  // PATHBENCH_GPU_PIXEL_REFILL_MIN (1-32): the warp shades its finished lanes once fewer than
-  // this many still walk.
-  bool refill = false;
-  uint32_t refill_min_active = kRefillMinActive;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // The latency-bound build: 8 blocks (32 registers, ~700 bytes of spills) since the slab
@@ -103,11 +94,6 @@ struct PixelCounters {
 // pixel_occupancy (float and watertight only: the accuracy variants keep the compiler's).
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
-                      DeviceBuffer<PixelCounters>& counters, const PixelOccupancy& occupancy);
-// The refill megakernel (pixel_refill.cu): a binary BVH without instances, float, watertight,
-// at 5 or kPixelLatencyBlocks blocks.
-FrameResult run_pixel_refill(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
-                             uint64_t total, FilmDev film, bool variance, DeviceBuffer<PixelCounters>& counters,
-                             int min_blocks, bool parked, uint32_t min_active);
+                      DeviceBuffer<PixelCounters>& counters, int min_blocks, bool parked = false);
 
 }  // namespace pb::gpu

@@ -17,7 +17,6 @@
 #include "pathbench/gpu/render.h"
 #include "pathbench/run/run.h"
 #include "film_agreement.h"
-#include "gpu_film_check.h"
 #include "traversal_check.h"
 #if __has_include("../unit/stat_test.h")
 #include "../unit/stat_test.h"
@@ -27,6 +26,58 @@
 namespace pb::gpu {
 using namespace pb::bvh;  // the BVH library (bvh/) the tracer under test uses
 namespace {
+
+#define PB_REQUIRE_GPU()                                        \
+  do {                                                          \
+    std::string why;                                            \
+    if (!device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
+  } while (0)
+
+RenderSettings small_settings(Strategy strategy, uint32_t size = 64, uint32_t spp = 32) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.max_bounces = 2;
+  s.sampling = Sampling::Nee;
+  s.strategy = strategy;
+  s.device = Device::Gpu;
+  s.seed = 1234;
+  s.progress = false;
+  return s;
+}
+
+Film render_gpu(const Scene& scene, const GpuScene& gs, RenderSettings s, RunReport* out = nullptr) {
+  Film film(s.width, s.height, s.variance);
+  RunReport r;
+  film.begin(s.spp, scene.max_emission());  // as the run layer does before it calls the tracer
+  render(scene, gs, s, film, r, false);
+  EXPECT_EQ(r.paths, s.total_samples());
+  EXPECT_EQ(r.discarded_samples, 0u);
+  if (out) *out = r;
+  return film;
+}
+
+// The render refuses the settings (an environment variable's value) with an InputError
+// naming `variable`.
+void expect_refused_naming(const Scene& scene, const GpuScene& gs, const RenderSettings& s, const char* variable) {
+  Film f(s.width, s.height, false);
+  RunReport r;
+  f.begin(s.spp, scene.max_emission());
+  try {
+    render(scene, gs, s, f, r, false);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(variable), std::string::npos) << e.what();
+  }
+}
+
+void expect_identical(const Film& a, const Film& b, const char* what) {
+  ASSERT_EQ(a.raw_sums().size(), b.raw_sums().size());
+  size_t differ = 0;
+  for (size_t i = 0; i < a.raw_sums().size(); ++i) differ += a.raw_sums()[i] != b.raw_sums()[i];
+  EXPECT_EQ(differ, 0u) << what << ": film sums differ in " << differ << " values";
+  EXPECT_EQ(a.counts(), b.counts()) << what;
+}
 
 struct StrategyCase {
   const char* scene;
