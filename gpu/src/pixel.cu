@@ -4,8 +4,6 @@
 #include <cuda_runtime.h>
 #include <fmt/core.h>
 
-#include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <type_traits>
@@ -125,48 +123,6 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
                                  kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
-// Experiment (issue 32): PATHBENCH_GPU_L2_PERSIST=nodes|nodes+tris marks the binary BVH's nodes
-// (and triangles) as persisting in L2 for this stream's kernels (an access policy window over
-// the persisting part of L2, as much of it as the device allows), so that a mesh larger than L2
-// keeps its nodes there instead of letting triangles evict them.
-void l2_window(cudaStream_t stream, const GpuScene::Impl& g) {
-  const char* env = std::getenv("PATHBENCH_GPU_L2_PERSIST");
-  if (!env || std::string(env) == "0" || g.nodes.bytes() == 0) return;
-  const bool tris = std::string(env) == "nodes+tris";
-  if (!tris && std::string(env) != "nodes")
-    throw InputError(fmt::format("PATHBENCH_GPU_L2_PERSIST={}: expected 0, nodes or nodes+tris", env));
-  int dev = 0;
-  PB_CUDA_CHECK(cudaGetDevice(&dev));
-  cudaDeviceProp p{};
-  PB_CUDA_CHECK(cudaGetDeviceProperties(&p, dev));
-  PB_CUDA_CHECK(cudaDeviceSetLimit(cudaLimitPersistingL2CacheSize, size_t(p.persistingL2CacheMaxSize)));
-  // One window: the nodes, or the nodes and the triangles if they lie in one allocation's reach.
-  const char* base = reinterpret_cast<const char*>(g.nodes.get());
-  size_t bytes = g.nodes.bytes();
-  if (tris) {
-    const char* t = reinterpret_cast<const char*>(g.tris.get());
-    const char* lo = std::min(base, t);
-    const char* hi = std::max(base + bytes, t + g.tris.bytes());
-    base = lo;
-    bytes = size_t(hi - lo);
-  }
-  bytes = std::min(bytes, size_t(p.accessPolicyMaxWindowSize));
-  cudaStreamAttrValue a{};
-  a.accessPolicyWindow.base_ptr = const_cast<char*>(base);
-  a.accessPolicyWindow.num_bytes = bytes;
-  a.accessPolicyWindow.hitRatio = float(std::min(1.0, double(p.persistingL2CacheMaxSize) / double(bytes)));
-  a.accessPolicyWindow.hitProp = cudaAccessPropertyPersisting;
-  a.accessPolicyWindow.missProp = cudaAccessPropertyStreaming;
-  PB_CUDA_CHECK(cudaStreamSetAttribute(stream, cudaStreamAttributeAccessPolicyWindow, &a));
-  static bool told = false;
-  if (!told) {
-    std::fprintf(stderr, "[l2] persisting %zu of %zu MB, window %.1f MB, hit ratio %.2f\n",
-                 size_t(p.persistingL2CacheMaxSize) >> 20, size_t(p.l2CacheSize) >> 20, bytes / 1048576.0,
-                 double(a.accessPolicyWindow.hitRatio));
-    told = true;
-  }
-}
-
 }  // namespace
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
@@ -191,7 +147,6 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
 FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Impl& g, const PathConfig& c,
                       uint64_t total, FilmDev film, bool variance, Precision precision, bool watertight,
                       DeviceBuffer<PixelCounters>& counters, int min_blocks, bool parked) {
-  l2_window(stream, g);
   PB_CUDA_CHECK(cudaMemsetAsync(counters.get(), 0, sizeof(PixelCounters), stream));
   // The megakernel compiled for the scene's material kinds (features.h).
   // In float with the watertight test, compiled for the scene's BVH layout and the

@@ -72,11 +72,6 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
       uint32_t child[2];
       load_node(nodes, ref, x, y, z, child);
       if (stats) ++stats->nodes;
-#if defined(__CUDA_ARCH__) && defined(PB_PREFETCH_CHILDREN) && PB_PREFETCH_CHILDREN == 1
-      // Experiment (issue 32): both inner children's lines on their way to L1 before the slab test.
-      for (int c = 0; c < 2; ++c)
-        if (!is_leaf(child[c])) asm volatile("prefetch.global.L1 [%0];" ::"l"(nodes + child[c]));
-#endif
       float tn[2], tf[2];
       for (int c = 0; c < 2; ++c)
         slab_interval(x[2 * c], x[2 * c + 1], y[2 * c], y[2 * c + 1], z[2 * c], z[2 * c + 1], sr, t, tn[c], tf[c]);
@@ -85,10 +80,6 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
         const bool swap = tn[1] < tn[0];
         ref = swap ? child[1] : child[0];
         stack[sp++] = swap ? child[0] : child[1];
-#if defined(__CUDA_ARCH__) && defined(PB_PREFETCH_CHILDREN) && PB_PREFETCH_CHILDREN == 2
-        // Experiment (issue 32): the pushed child's line on its way to L1 while the near one is walked.
-        if (!is_leaf(stack[sp - 1])) asm volatile("prefetch.global.L1 [%0];" ::"l"(nodes + stack[sp - 1]));
-#endif
       } else if (h0 || h1) {
         ref = h0 ? child[0] : child[1];
       } else {
