@@ -1,5 +1,4 @@
 #include "pathbench/bvh/bvh_layout.h"
-#include "pathbench/bvh/wide4_float.h"
 
 #include <fmt/core.h>
 
@@ -154,10 +153,6 @@ SceneBvhHost build_scene_bvh(const Scene& scene, const GpuBvhOptions& options) {
       out.binary_leaves = out.binary.leaves;
       out.binary_sah = out.binary.sah_cost;
     }
-#if defined(PB_BINARY_AS_WIDE4) && PB_BINARY_AS_WIDE4
-    if (out.layout == GpuBvhLayout::Binary && scene.instances.empty())  // experiment: wide4_float.h
-      out.binary.nodes = collapse_to_wide4(out.binary.nodes, out.binary.depth);
-#endif
     if (wide) {
       out.wide = collapse_bvh(out.binary, out.layout == GpuBvhLayout::Wide4 ? 4 : 8);
       out.binary = BvhHost{};

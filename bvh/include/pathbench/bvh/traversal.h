@@ -14,7 +14,6 @@
 #include "pathbench/bvh/rects_binary.h"
 #include "pathbench/bvh/two_level_bvh.h"
 #include "pathbench/bvh/wide_bvh.h"
-#include "pathbench/bvh/wide4_float.h"
 #include "pathbench/common/hd.h"
 
 namespace pb::bvh {
@@ -60,11 +59,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
   } else if constexpr (kKind == int(TraversalKind::AllTriangles)) {
     return traverse_all<kAnyHit, kWatertight>(bvh.tris, bvh.num_tris, o, d, t_max, t_hit, stats, bvh.exact_ties != 0);
   } else if constexpr (kKind == int(TraversalKind::Binary)) {
-#if defined(PB_BINARY_AS_WIDE4) && PB_BINARY_AS_WIDE4
-    return traverse_wide4<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
-#else
     return traverse<kAnyHit, kWatertight, 0>(bvh.binary, o, d, t_max, t_hit, stats);
-#endif
   } else if constexpr (kKind == kBinaryExactTies) {
     return traverse<kAnyHit, kWatertight, 1>(bvh.binary, o, d, t_max, t_hit, stats);
   } else if constexpr (kKind == int(TraversalKind::TwoLevel)) {
@@ -90,11 +85,7 @@ PB_HD uint32_t traverse(const BvhView& bvh, const Vec3f& o, const Vec3f& d, floa
         else return traverse_rects<kAnyHit>(bvh.leaves.rects, bvh.leaves.rect_groups, o, d, t_max, t_hit, stats);
       case TraversalKind::RectsBinary:
         return traverse_rects_binary<kAnyHit, kWatertight>(bvh.rects_binary, o, d, t_max, t_hit, stats);
-      default:
-#if defined(PB_BINARY_AS_WIDE4) && PB_BINARY_AS_WIDE4
-        if (!bvh.binary.exact_ties) return traverse_wide4<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
-#endif
-        return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
+      default: return traverse<kAnyHit, kWatertight>(bvh.binary, o, d, t_max, t_hit, stats);
     }
   }
 }
