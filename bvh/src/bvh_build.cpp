@@ -214,6 +214,7 @@ BvhBuildOptions BvhBuildOptions::with_env() const {
   number("PATHBENCH_GPU_BVH_LEAF_SIZE", 1, kMaxLeafPrims, o.max_leaf_size);
   number("PATHBENCH_GPU_BVH_TRAVERSAL_COST", 1e-3, 1e3, o.traversal_cost);
   number("PATHBENCH_GPU_BVH_INTERSECTION_COST", 1e-3, 1e3, o.intersection_cost);
+  number("PATHBENCH_GPU_BVH_OPTIMIZE", 0, 8, o.optimize_passes);
   if (const char* v = std::getenv("PATHBENCH_GPU_BVH_QUALITY"); v && *v) {
     const std::string_view q(v);
     if (q != "medium" && q != "high")
@@ -337,6 +338,11 @@ BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options, const std:
     throw std::runtime_error(fmt::format("bvh: depth {} exceeds the traversal stack ({})", out.depth, kTraversalStackSize));
   const double root_area = std::max(root_box.area(), 1e-30);
   out.sah_cost = (flat.inner_cost_ + flat.leaf_cost_) / root_area;
+  if (options.optimize_passes > 0) {
+    const BvhOptimizeResult r = optimize_treelets(out.nodes, options);
+    out.depth = r.depth;
+    out.sah_cost *= r.cost_after / std::max(r.cost_before, 1e-300);  // the build's SAH, scaled by the gain
+  }
   out.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -16,9 +16,11 @@ struct BvhBuildOptions {
   float traversal_cost = 1.0f;    // SAH cost of visiting a node, relative to...
   float intersection_cost = 1.0f; // ...testing one triangle
   bool high_quality = false;      // Embree's HIGH quality (spatial splits)
+  unsigned optimize_passes = 0;   // treelet restructuring passes after the build (bvh_optimize.cpp)
   // These options with the environment's overrides, for measuring builds without
   // rebuilding: PATHBENCH_GPU_BVH_LEAF_SIZE=1..16, PATHBENCH_GPU_BVH_QUALITY=medium|high,
-  // PATHBENCH_GPU_BVH_TRAVERSAL_COST=<x>, PATHBENCH_GPU_BVH_INTERSECTION_COST=<x> (x > 0).
+  // PATHBENCH_GPU_BVH_TRAVERSAL_COST=<x>, PATHBENCH_GPU_BVH_INTERSECTION_COST=<x> (x > 0),
+  // PATHBENCH_GPU_BVH_OPTIMIZE=0..8 (treelet restructuring passes).
   // Throws InputError naming the variable for a value it cannot use.
   BvhBuildOptions with_env() const;
 };
@@ -37,6 +39,17 @@ struct BvhHost {
   }
   uint64_t bytes() const { return nodes.size() * sizeof(BvhNode) + tris.size() * sizeof(BvhTriangle); }
 };
+
+// Treelet restructuring (Karras & Aila 2013) of a flattened binary BVH, in place: `passes`
+// bottom-up passes, each node's treelet of up to 7 subtrees rearranged into the binary tree of
+// least SAH cost; the nodes then renumbered depth first. A result deeper than the traversal
+// stack allows is dropped (kept = false) and the nodes are the build's again.
+struct BvhOptimizeResult {
+  double cost_before = 0, cost_after = 0;  // SAH cost of the stored (padded) boxes, unnormalised
+  uint32_t depth = 0;
+  bool kept = true;
+};
+BvhOptimizeResult optimize_treelets(std::vector<BvhNode>& nodes, const BvhBuildOptions& options);
 
 // Scene triangle `id` as the traversals' 48-byte record (its vertices and id).
 BvhTriangle bvh_triangle(const Scene& scene, uint32_t id);

@@ -1,0 +1,230 @@
+// Treelet restructuring of the flattened binary BVH (Karras & Aila, "Fast Parallel Construction
+// of High-Quality Bounding Volume Hierarchies", HPG 2013): bottom-up, each inner node and up to
+// six of its descendants (the treelet: expanded by largest area until it has 7 leaves) are
+// rearranged into the binary tree over the same 7 subtrees with the least SAH cost, found by
+// dynamic programming over the subsets of the leaves. Leaves and their triangles stay as they
+// are, and so do the boxes of the subtrees below a treelet. A treelet's new inner nodes bound
+// the (padded) boxes they join. The nodes are then renumbered depth first.
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "pathbench/bvh/bvh_build.h"
+
+namespace pb::bvh {
+
+namespace {
+
+struct Box {
+  float lo[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                 std::numeric_limits<float>::infinity()};
+  float hi[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                 -std::numeric_limits<float>::infinity()};
+  void grow(const Box& b) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], b.lo[k]);
+      hi[k] = std::max(hi[k], b.hi[k]);
+    }
+  }
+  double area() const {
+    if (!(lo[0] <= hi[0])) return 0;
+    const double x = double(hi[0]) - lo[0], y = double(hi[1]) - lo[1], z = double(hi[2]) - lo[2];
+    return 2.0 * (x * y + y * z + z * x);
+  }
+};
+
+bool empty_slot(const BvhNode& n, int c) { return n.x[2 * c] == std::numeric_limits<float>::infinity(); }
+
+Box slot_box(const BvhNode& n, int c) {
+  Box b;
+  b.lo[0] = n.x[2 * c]; b.hi[0] = n.x[2 * c + 1];
+  b.lo[1] = n.y[2 * c]; b.hi[1] = n.y[2 * c + 1];
+  b.lo[2] = n.z[2 * c]; b.hi[2] = n.z[2 * c + 1];
+  return b;
+}
+
+void set_slot(BvhNode& n, int c, uint32_t ref, const Box& b) {
+  n.x[2 * c] = b.lo[0]; n.x[2 * c + 1] = b.hi[0];
+  n.y[2 * c] = b.lo[1]; n.y[2 * c + 1] = b.hi[1];
+  n.z[2 * c] = b.lo[2]; n.z[2 * c + 1] = b.hi[2];
+  n.child[c] = ref;
+}
+
+constexpr int kTreeletLeaves = 7;
+
+class Restructurer {
+ public:
+  Restructurer(std::vector<BvhNode>& nodes, double ct, double ci) : n_(nodes), ct_(ct), ci_(ci), cost_(nodes.size()) {}
+
+  // One bottom-up pass; returns the tree's SAH cost (unnormalised) after it.
+  double pass() {
+    post_order(0, true);
+    return cost_[0];
+  }
+  double cost() {
+    post_order(0, false);
+    return cost_[0];
+  }
+
+ private:
+  // A subtree's cost: a leaf's triangles, or a node's own cost and its children's.
+  double ref_cost(uint32_t ref, const Box& b) const {
+    return is_leaf(ref) ? ct_ * b.area() * leaf_count(ref) : cost_[ref];
+  }
+  void update_cost(uint32_t i) {
+    const BvhNode& n = n_[i];
+    Box u;
+    double c = 0;
+    for (int k = 0; k < 2; ++k) {
+      if (empty_slot(n, k)) continue;
+      const Box b = slot_box(n, k);
+      u.grow(b);
+      c += ref_cost(n.child[k], b);
+    }
+    cost_[i] = c + ci_ * u.area();
+  }
+
+  void post_order(uint32_t root, bool restructure) {
+    // Iterative post order: a node after both its children.
+    std::vector<std::pair<uint32_t, bool>> stack{{root, false}};
+    while (!stack.empty()) {
+      auto [i, seen] = stack.back();
+      stack.pop_back();
+      if (seen) {
+        update_cost(i);
+        if (restructure) treelet(i);
+        continue;
+      }
+      stack.push_back({i, true});
+      for (int k = 0; k < 2; ++k)
+        if (!empty_slot(n_[i], k) && !is_leaf(n_[i].child[k])) stack.push_back({n_[i].child[k], false});
+    }
+  }
+
+  void treelet(uint32_t root) {
+    const BvhNode& r = n_[root];
+    if (empty_slot(r, 0) || empty_slot(r, 1)) return;
+    uint32_t leaf_ref[kTreeletLeaves];
+    Box leaf_box[kTreeletLeaves];
+    int n = 0;
+    for (int k = 0; k < 2; ++k) { leaf_ref[n] = r.child[k]; leaf_box[n] = slot_box(r, k); ++n; }
+    uint32_t inner[kTreeletLeaves - 1] = {root};
+    int ni = 1;
+    while (n < kTreeletLeaves) {  // open the largest inner treelet leaf with two children
+      int best = -1;
+      for (int k = 0; k < n; ++k) {
+        if (is_leaf(leaf_ref[k])) continue;
+        const BvhNode& c = n_[leaf_ref[k]];
+        if (empty_slot(c, 0) || empty_slot(c, 1)) continue;
+        if (best < 0 || leaf_box[k].area() > leaf_box[best].area()) best = k;
+      }
+      if (best < 0) break;
+      const uint32_t opened = leaf_ref[best];
+      const BvhNode& c = n_[opened];
+      inner[ni++] = opened;
+      leaf_ref[best] = c.child[0]; leaf_box[best] = slot_box(c, 0);
+      leaf_ref[n] = c.child[1]; leaf_box[n] = slot_box(c, 1);
+      ++n;
+    }
+    if (n < 3) return;
+    const uint32_t full = (1u << n) - 1;
+    Box box[1 << kTreeletLeaves];
+    double area[1 << kTreeletLeaves], best_cost[1 << kTreeletLeaves];
+    uint32_t split[1 << kTreeletLeaves] = {};
+    for (uint32_t m = 1; m <= full; ++m) {
+      const int low = __builtin_ctz(m);
+      box[m] = box[m & (m - 1)];
+      box[m].grow(leaf_box[low]);
+      area[m] = box[m].area();
+    }
+    for (int k = 0; k < n; ++k) best_cost[1u << k] = ref_cost(leaf_ref[k], leaf_box[k]);
+    for (uint32_t m = 1; m <= full; ++m) {
+      if ((m & (m - 1)) == 0) continue;
+      // Partitions (p, m ^ p) with p holding m's lowest leaf: each split once.
+      const uint32_t low = m & (~m + 1), rest = m ^ low;
+      double b = std::numeric_limits<double>::infinity();
+      uint32_t bp = 0;
+      for (uint32_t s = (rest - 1) & rest;; s = (s - 1) & rest) {  // s: proper subsets of rest
+        const uint32_t p = s | low;
+        const double c = best_cost[p] + best_cost[m ^ p];
+        if (c < b) { b = c; bp = p; }
+        if (s == 0) break;
+      }
+      best_cost[m] = b + ci_ * area[m];
+      split[m] = bp;
+    }
+    if (!(best_cost[full] < cost_[root] * (1.0 - 1e-9))) return;  // no gain: leave it
+    int next_inner = 1;
+    rebuild(full, root, split, leaf_ref, leaf_box, box, best_cost, inner, next_inner);
+  }
+
+  // Writes the subtree of leaf set m into node `at` (m has two or more leaves).
+  void rebuild(uint32_t m, uint32_t at, const uint32_t* split, const uint32_t* leaf_ref, const Box* leaf_box,
+               const Box* box, const double* best_cost, const uint32_t* inner, int& next_inner) {
+    const uint32_t part[2] = {split[m], m ^ split[m]};
+    for (int k = 0; k < 2; ++k) {
+      const uint32_t p = part[k];
+      if ((p & (p - 1)) == 0) {
+        const int leaf = __builtin_ctz(p);
+        set_slot(n_[at], k, leaf_ref[leaf], leaf_box[leaf]);
+      } else {
+        const uint32_t idx = inner[next_inner++];
+        rebuild(p, idx, split, leaf_ref, leaf_box, box, best_cost, inner, next_inner);
+        set_slot(n_[at], k, idx, box[p]);
+      }
+    }
+    cost_[at] = best_cost[m];
+  }
+
+  std::vector<BvhNode>& n_;
+  double ct_, ci_;
+  std::vector<double> cost_;
+};
+
+// Depth-first renumbering (the order the flattener writes): node 0 the root, each node's
+// first child right after it. Returns the depth in inner nodes.
+uint32_t renumber(std::vector<BvhNode>& nodes) {
+  std::vector<BvhNode> out;
+  out.reserve(nodes.size());
+  uint32_t depth = 0;
+  struct Item { uint32_t old, parent; int slot; uint32_t level; };
+  std::vector<Item> stack{{0, 0, -1, 0}};
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const uint32_t idx = uint32_t(out.size());
+    out.push_back(nodes[it.old]);
+    if (it.slot >= 0) out[it.parent].child[it.slot] = idx;
+    depth = std::max(depth, it.level);
+    for (int k = 1; k >= 0; --k) {  // child 0 popped first
+      const BvhNode& n = nodes[it.old];
+      if (!empty_slot(n, k) && !is_leaf(n.child[k])) stack.push_back({n.child[k], idx, k, it.level + 1});
+    }
+  }
+  nodes.swap(out);
+  return depth;
+}
+
+}  // namespace
+
+BvhOptimizeResult optimize_treelets(std::vector<BvhNode>& nodes, const BvhBuildOptions& o) {
+  BvhOptimizeResult r;
+  if (nodes.empty() || o.optimize_passes == 0) return r;
+  std::vector<BvhNode> before = nodes;
+  Restructurer t(nodes, o.intersection_cost, o.traversal_cost);
+  r.cost_before = t.cost();
+  r.cost_after = r.cost_before;
+  for (uint32_t p = 0; p < o.optimize_passes; ++p) r.cost_after = t.pass();
+  r.depth = renumber(nodes);
+  if (r.depth + 1 > uint32_t(kTraversalStackSize)) {  // too deep for the traversal stack: keep the build
+    nodes.swap(before);
+    r.depth = renumber(nodes);
+    r.cost_after = r.cost_before;
+    r.kept = false;
+  }
+  return r;
+}
+
+}  // namespace pb::bvh
