@@ -340,7 +340,13 @@ BvhHost build_bvh(const Scene& scene, const BvhBuildOptions& options, const std:
   out.sah_cost = (flat.inner_cost_ + flat.leaf_cost_) / root_area;
   if (options.optimize_passes > 0) {
     const BvhOptimizeResult r = optimize_treelets(out.nodes, options);
+    if (r.depth + 1 > uint32_t(kTraversalStackSize)) {  // too deep for the traversal stack: Embree's tree
+      BvhBuildOptions plain = options;
+      plain.optimize_passes = 0;
+      return build_bvh(scene, plain, leave_out);
+    }
     out.depth = r.depth;
+    out.treelet_passes = options.optimize_passes;
     out.sah_cost *= r.cost_after / std::max(r.cost_before, 1e-300);  // the build's SAH, scaled by the gain
   }
   out.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "pathbench/bvh/bvh_build.h"
 
 namespace pb::bvh {
@@ -58,13 +60,19 @@ class Restructurer {
  public:
   Restructurer(std::vector<BvhNode>& nodes, double ct, double ci) : n_(nodes), ct_(ct), ci_(ci), cost_(nodes.size()) {}
 
-  // One bottom-up pass; returns the tree's SAH cost (unnormalised) after it.
+  // One bottom-up pass; returns the tree's SAH cost (unnormalised) after it. The subtrees
+  // below kCutDepth are passed in parallel (a treelet lies inside its root's subtree, so
+  // disjoint subtrees never touch the same node), then the levels above them in order: the
+  // result does not depend on the threads.
   double pass() {
-    post_order(0, true);
+    std::vector<uint32_t> cut;
+    collect(0, 0, cut);
+    tbb::parallel_for(size_t(0), cut.size(), [&](size_t i) { post_order(cut[i], true, kNoLimit); });
+    post_order(0, true, kCutDepth);
     return cost_[0];
   }
   double cost() {
-    post_order(0, false);
+    post_order(0, false, kNoLimit);
     return cost_[0];
   }
 
@@ -86,20 +94,37 @@ class Restructurer {
     cost_[i] = c + ci_ * u.area();
   }
 
-  void post_order(uint32_t root, bool restructure) {
-    // Iterative post order: a node after both its children.
-    std::vector<std::pair<uint32_t, bool>> stack{{root, false}};
+  static constexpr uint32_t kCutDepth = 8, kNoLimit = ~0u;
+
+  // The inner nodes at kCutDepth (the roots of the subtrees passed in parallel).
+  void collect(uint32_t i, uint32_t depth, std::vector<uint32_t>& cut) const {
+    if (depth == kCutDepth) {
+      cut.push_back(i);
+      return;
+    }
+    for (int k = 0; k < 2; ++k)
+      if (!empty_slot(n_[i], k) && !is_leaf(n_[i].child[k])) collect(n_[i].child[k], depth + 1, cut);
+  }
+
+  // Iterative post order from `root`: a node after both its children. Nodes `limit` levels
+  // below the root are taken as done (their subtrees were passed already).
+  void post_order(uint32_t root, bool restructure, uint32_t limit) {
+    struct Item { uint32_t node, depth; bool seen; };
+    std::vector<Item> stack{{root, 0, false}};
     while (!stack.empty()) {
-      auto [i, seen] = stack.back();
+      const Item it = stack.back();
       stack.pop_back();
-      if (seen) {
-        update_cost(i);
-        if (restructure) treelet(i);
+      if (it.seen) {
+        update_cost(it.node);
+        if (restructure) treelet(it.node);
         continue;
       }
-      stack.push_back({i, true});
-      for (int k = 0; k < 2; ++k)
-        if (!empty_slot(n_[i], k) && !is_leaf(n_[i].child[k])) stack.push_back({n_[i].child[k], false});
+      stack.push_back({it.node, it.depth, true});
+      if (it.depth + 1 >= limit) continue;
+      for (int k = 0; k < 2; ++k) {
+        const BvhNode& n = n_[it.node];
+        if (!empty_slot(n, k) && !is_leaf(n.child[k])) stack.push_back({n.child[k], it.depth + 1, false});
+      }
     }
   }
 
@@ -184,7 +209,8 @@ class Restructurer {
 };
 
 // Depth-first renumbering (the order the flattener writes): node 0 the root, each node's
-// first child right after it. Returns the depth in inner nodes.
+// first child right after it. Returns the depth as the flattener counts it: the inner nodes
+// on the longest path from the root to a leaf.
 uint32_t renumber(std::vector<BvhNode>& nodes) {
   std::vector<BvhNode> out;
   out.reserve(nodes.size());
@@ -197,7 +223,7 @@ uint32_t renumber(std::vector<BvhNode>& nodes) {
     const uint32_t idx = uint32_t(out.size());
     out.push_back(nodes[it.old]);
     if (it.slot >= 0) out[it.parent].child[it.slot] = idx;
-    depth = std::max(depth, it.level);
+    depth = std::max(depth, it.level + 1);
     for (int k = 1; k >= 0; --k) {  // child 0 popped first
       const BvhNode& n = nodes[it.old];
       if (!empty_slot(n, k) && !is_leaf(n.child[k])) stack.push_back({n.child[k], idx, k, it.level + 1});
@@ -212,18 +238,11 @@ uint32_t renumber(std::vector<BvhNode>& nodes) {
 BvhOptimizeResult optimize_treelets(std::vector<BvhNode>& nodes, const BvhBuildOptions& o) {
   BvhOptimizeResult r;
   if (nodes.empty() || o.optimize_passes == 0) return r;
-  std::vector<BvhNode> before = nodes;
   Restructurer t(nodes, o.intersection_cost, o.traversal_cost);
   r.cost_before = t.cost();
   r.cost_after = r.cost_before;
   for (uint32_t p = 0; p < o.optimize_passes; ++p) r.cost_after = t.pass();
   r.depth = renumber(nodes);
-  if (r.depth + 1 > uint32_t(kTraversalStackSize)) {  // too deep for the traversal stack: keep the build
-    nodes.swap(before);
-    r.depth = renumber(nodes);
-    r.cost_after = r.cost_before;
-    r.kept = false;
-  }
   return r;
 }
 

@@ -36,7 +36,7 @@ struct GpuScene::Impl {
   uint64_t bytes = 0;
   GpuBvhLayout layout = GpuBvhLayout::Binary;
   uint32_t bvh_nodes = 0, bvh_node_bytes = 0, bvh_tris = 0;
-  uint32_t bvh_depth = 0, bvh_leaves = 0;
+  uint32_t bvh_depth = 0, bvh_leaves = 0, bvh_treelet_passes = 0;
   double bvh_sah = 0, bvh_build_seconds = 0;
   uint64_t bvh_bytes = 0;  // the acceleration structure's part of `bytes`
   nlohmann::json instancing;  // what the report says of --instancing (scene_upload.cu)

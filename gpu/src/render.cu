@@ -339,7 +339,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
   x["scene_device_bytes"] = g.bytes;
   x["bvh"] = {{"layout", to_string(g.layout)}, {"nodes", g.bvh_nodes}, {"node_bytes", g.bvh_node_bytes},
               {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth},
-              {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds},
+              {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds}, {"treelet_passes", g.bvh_treelet_passes},
               {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
                           : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"
                           : g.layout == GpuBvhLayout::Leaves ? "embree rtcBuildBVH, binned SAH, binary: its leaves, no inner nodes"

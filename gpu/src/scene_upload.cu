@@ -81,6 +81,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuBvhOptions& options) : impl_(std
   m.bvh_tris = uint32_t(m.tris.size());
   const bool binary = bvh.layout == GpuBvhLayout::Binary || bvh.layout == GpuBvhLayout::RectsBinary;
   m.bvh_depth = binary ? bvh.binary_depth : bvh.wide.depth;
+  m.bvh_treelet_passes = binary ? bvh.binary.treelet_passes : 0;
   m.bvh_leaves = binary ? bvh.binary_leaves : bvh.wide.leaves;
   if (bvh.layout == GpuBvhLayout::Leaves) {  // one level: the leaves
     m.bvh_depth = 1;

@@ -782,9 +782,12 @@ TEST(BvhBuildOptions, EnvironmentOverrides) {
   EXPECT_TRUE(with("PATHBENCH_GPU_BVH_QUALITY", "high").high_quality);
   EXPECT_FLOAT_EQ(with("PATHBENCH_GPU_BVH_TRAVERSAL_COST", "2.5").traversal_cost, 2.5f);
   EXPECT_FLOAT_EQ(with("PATHBENCH_GPU_BVH_INTERSECTION_COST", "0.5").intersection_cost, 0.5f);
+  EXPECT_EQ(with("PATHBENCH_GPU_BVH_OPTIMIZE", "0").optimize_passes, 0u);
+  EXPECT_EQ(with("PATHBENCH_GPU_BVH_OPTIMIZE", "8").optimize_passes, 8u);
   for (const auto& [var, bad] : {std::pair{"PATHBENCH_GPU_BVH_LEAF_SIZE", "17"}, {"PATHBENCH_GPU_BVH_LEAF_SIZE", "2.5"},
                                  {"PATHBENCH_GPU_BVH_LEAF_SIZE", "four"}, {"PATHBENCH_GPU_BVH_QUALITY", "best"},
-                                 {"PATHBENCH_GPU_BVH_TRAVERSAL_COST", "0"}}) {
+                                 {"PATHBENCH_GPU_BVH_TRAVERSAL_COST", "0"}, {"PATHBENCH_GPU_BVH_OPTIMIZE", "9"},
+                                 {"PATHBENCH_GPU_BVH_OPTIMIZE", "-1"}, {"PATHBENCH_GPU_BVH_OPTIMIZE", "1.5"}}) {
     try {
       with(var, bad);
       ADD_FAILURE() << var << "=" << bad << " was taken";

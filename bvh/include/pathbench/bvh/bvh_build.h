@@ -16,7 +16,10 @@ struct BvhBuildOptions {
   float traversal_cost = 1.0f;    // SAH cost of visiting a node, relative to...
   float intersection_cost = 1.0f; // ...testing one triangle
   bool high_quality = false;      // Embree's HIGH quality (spatial splits)
-  unsigned optimize_passes = 0;   // treelet restructuring passes after the build (bvh_optimize.cpp)
+  // Treelet restructuring passes after the build (bvh_optimize.cpp). Measured on an H100,
+  // interleaved (docs/notes/gpu-log.md, "Treelet restructuring"): 3 passes took the pixel
+  // megakernel 4-6 % faster on the suite's meshes; 0 leaves Embree's tree as built.
+  unsigned optimize_passes = 3;
   // These options with the environment's overrides, for measuring builds without
   // rebuilding: PATHBENCH_GPU_BVH_LEAF_SIZE=1..16, PATHBENCH_GPU_BVH_QUALITY=medium|high,
   // PATHBENCH_GPU_BVH_TRAVERSAL_COST=<x>, PATHBENCH_GPU_BVH_INTERSECTION_COST=<x> (x > 0),
@@ -33,6 +36,7 @@ struct BvhHost {
   double sah_cost = 0;      // expected cost of a random ray, in the options' units
   double build_seconds = 0;
   float pad = 0;            // every box was grown by this (a few ulps of the largest coordinate)
+  uint32_t treelet_passes = 0;  // treelet restructuring passes the tree went through (optimize_treelets)
 
   BinaryBvhView view() const {
     return {nodes.data(), tris.data(), uint32_t(nodes.size()), uint32_t(tris.size())};
@@ -42,12 +46,11 @@ struct BvhHost {
 
 // Treelet restructuring (Karras & Aila 2013) of a flattened binary BVH, in place: `passes`
 // bottom-up passes, each node's treelet of up to 7 subtrees rearranged into the binary tree of
-// least SAH cost; the nodes then renumbered depth first. A result deeper than the traversal
-// stack allows is dropped (kept = false) and the nodes are the build's again.
+// least SAH cost; the nodes then renumbered depth first. (It may deepen the tree: build_bvh
+// builds again without it where the result is deeper than the traversal stack allows.)
 struct BvhOptimizeResult {
   double cost_before = 0, cost_after = 0;  // SAH cost of the stored (padded) boxes, unnormalised
-  uint32_t depth = 0;
-  bool kept = true;
+  uint32_t depth = 0;                      // in inner nodes, as BvhHost::depth
 };
 BvhOptimizeResult optimize_treelets(std::vector<BvhNode>& nodes, const BvhBuildOptions& options);
 
