@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "pathbench/common/errors.h"
+#include "build_box.h"
 
 namespace pb::bvh {
 
@@ -72,19 +73,7 @@ void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims,
   return l;
 }
 
-struct Box {
-  Vec3f lo{std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
-           std::numeric_limits<float>::infinity()};
-  Vec3f hi{-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-           -std::numeric_limits<float>::infinity()};
-  void grow(Vec3f p) { lo = vmin(lo, p); hi = vmax(hi, p); }
-  bool empty() const { return lo.x > hi.x; }
-  double area() const {
-    if (empty()) return 0;
-    const Vec3f e = hi - lo;
-    return 2.0 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
-  }
-};
+using Box = BuildBox;
 
 class Flattener {
  public:
@@ -163,19 +152,17 @@ class Flattener {
     BvhNode& n = out_.nodes[idx];
     const Box* b[2] = {&b0, &b1};
     for (int c = 0; c < 2; ++c) {
-      Vec3f lo = b[c]->lo, hi = b[c]->hi;
-      if (b[c]->empty()) {
+      Box s = *b[c];
+      if (s.empty()) {
         // A box at +infinity: every slab distance is +-inf, so tn > tf for any ray.
         const float inf = std::numeric_limits<float>::infinity();
-        lo = {inf, inf, inf};
-        hi = {inf, inf, inf};
+        s.lo = {inf, inf, inf};
+        s.hi = {inf, inf, inf};
       } else {
-        lo = lo - Vec3f{pad_, pad_, pad_};
-        hi = hi + Vec3f{pad_, pad_, pad_};
+        s.lo = s.lo - Vec3f{pad_, pad_, pad_};
+        s.hi = s.hi + Vec3f{pad_, pad_, pad_};
       }
-      n.x[2 * c] = lo.x; n.x[2 * c + 1] = hi.x;
-      n.y[2 * c] = lo.y; n.y[2 * c + 1] = hi.y;
-      n.z[2 * c] = lo.z; n.z[2 * c + 1] = hi.z;
+      set_slot_box(n, c, s);
     }
     n.child[0] = r0;
     n.child[1] = r1;

@@ -14,43 +14,24 @@
 #include <tbb/parallel_for.h>
 
 #include "pathbench/bvh/bvh_build.h"
+#include "build_box.h"
 
 namespace pb::bvh {
 
 namespace {
 
-struct Box {
-  float lo[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
-                 std::numeric_limits<float>::infinity()};
-  float hi[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                 -std::numeric_limits<float>::infinity()};
-  void grow(const Box& b) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], b.lo[k]);
-      hi[k] = std::max(hi[k], b.hi[k]);
-    }
-  }
-  double area() const {
-    if (!(lo[0] <= hi[0])) return 0;
-    const double x = double(hi[0]) - lo[0], y = double(hi[1]) - lo[1], z = double(hi[2]) - lo[2];
-    return 2.0 * (x * y + y * z + z * x);
-  }
-};
+using Box = BuildBox;
 
-bool empty_slot(const BvhNode& n, int c) { return n.x[2 * c] == std::numeric_limits<float>::infinity(); }
-
-Box slot_box(const BvhNode& n, int c) {
-  Box b;
-  b.lo[0] = n.x[2 * c]; b.hi[0] = n.x[2 * c + 1];
-  b.lo[1] = n.y[2 * c]; b.hi[1] = n.y[2 * c + 1];
-  b.lo[2] = n.z[2 * c]; b.hi[2] = n.z[2 * c + 1];
-  return b;
+// The SAH's area of a box, its extents taken in double (the builders' Box::area takes them in
+// float): what the restructuring's costs and decisions were measured with.
+double sah_area(const Box& b) {
+  if (b.empty()) return 0;
+  const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+  return 2.0 * (x * y + y * z + z * x);
 }
 
 void set_slot(BvhNode& n, int c, uint32_t ref, const Box& b) {
-  n.x[2 * c] = b.lo[0]; n.x[2 * c + 1] = b.hi[0];
-  n.y[2 * c] = b.lo[1]; n.y[2 * c + 1] = b.hi[1];
-  n.z[2 * c] = b.lo[2]; n.z[2 * c + 1] = b.hi[2];
+  set_slot_box(n, c, b);
   n.child[c] = ref;
 }
 
@@ -79,7 +60,7 @@ class Restructurer {
  private:
   // A subtree's cost: a leaf's triangles, or a node's own cost and its children's.
   double ref_cost(uint32_t ref, const Box& b) const {
-    return is_leaf(ref) ? ct_ * b.area() * leaf_count(ref) : cost_[ref];
+    return is_leaf(ref) ? ct_ * sah_area(b) * leaf_count(ref) : cost_[ref];
   }
   void update_cost(uint32_t i) {
     const BvhNode& n = n_[i];
@@ -91,7 +72,7 @@ class Restructurer {
       u.grow(b);
       c += ref_cost(n.child[k], b);
     }
-    cost_[i] = c + ci_ * u.area();
+    cost_[i] = c + ci_ * sah_area(u);
   }
 
   static constexpr uint32_t kCutDepth = 8, kNoLimit = ~0u;
@@ -143,7 +124,7 @@ class Restructurer {
         if (is_leaf(leaf_ref[k])) continue;
         const BvhNode& c = n_[leaf_ref[k]];
         if (empty_slot(c, 0) || empty_slot(c, 1)) continue;
-        if (best < 0 || leaf_box[k].area() > leaf_box[best].area()) best = k;
+        if (best < 0 || sah_area(leaf_box[k]) > sah_area(leaf_box[best])) best = k;
       }
       if (best < 0) break;
       const uint32_t opened = leaf_ref[best];
@@ -162,7 +143,7 @@ class Restructurer {
       const int low = __builtin_ctz(m);
       box[m] = box[m & (m - 1)];
       box[m].grow(leaf_box[low]);
-      area[m] = box[m].area();
+      area[m] = sah_area(box[m]);
     }
     for (int k = 0; k < n; ++k) best_cost[1u << k] = ref_cost(leaf_ref[k], leaf_box[k]);
     for (uint32_t m = 1; m <= full; ++m) {

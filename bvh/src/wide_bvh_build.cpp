@@ -7,26 +7,13 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include "build_box.h"
 
 namespace pb::bvh {
 
 namespace {
 
-struct Box {
-  Vec3f lo{std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
-           std::numeric_limits<float>::infinity()};
-  Vec3f hi{-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-           -std::numeric_limits<float>::infinity()};
-  void grow(const Box& b) { lo = vmin(lo, b.lo); hi = vmax(hi, b.hi); }
-  // Never grown, or the binary BVH's mark of an empty slot (a box at +infinity).
-  bool empty() const { return !(lo.x <= hi.x) || lo.x == std::numeric_limits<float>::infinity(); }
-  double area() const {
-    if (empty()) return 0;
-    const Vec3f e = hi - lo;
-    return 2.0 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
-  }
-  Vec3f centre() const { return (lo + hi) * 0.5f; }
-};
+using Box = BuildBox;
 
 float axis(const Vec3f& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
@@ -54,8 +41,7 @@ class Collapser {
     const BvhNode& n = b_.nodes[it.node];
     for (int c = 0; c < 2; ++c) {
       Item ch;
-      ch.box.lo = {n.x[2 * c], n.y[2 * c], n.z[2 * c]};
-      ch.box.hi = {n.x[2 * c + 1], n.y[2 * c + 1], n.z[2 * c + 1]};
+      ch.box = slot_box(n, c);
       if (ch.box.empty()) continue;
       const uint32_t ref = n.child[c];
       if (is_leaf(ref)) {
