@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <limits>
 
-#include "pathbench/bvh/ray_pair.h"
 #include "pathbench/bvh/traversal.h"
 #include "pathbench/common/hd.h"
 #include "pathbench/common/path.h"
@@ -32,12 +31,10 @@ PB_HD bool gpu_final_vertex(const SceneView& s, const PathConfig& c, const PathS
 // The path's state st and its shadow query q live where the caller keeps them: in registers
 // (trace_path_bvh below), or in the GPU block's shared memory (pixel.cu's parked state,
 // which frees their registers while the traversals run).
-// Two loops with the same answer bit for bit: one ray at a time, or (the binary BVH's
-// kernels) a vertex's shadow segment walked together with the ray that leaves the vertex.
 template <uint32_t Kinds, class T, bool kWatertight, int kKind>
-PB_HD Vec3f trace_path_one_ray_at_a_time(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
-                                         uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow, PathState<T>& st,
-                                         ShadowQuery<T>& q) {
+PB_HD Vec3f trace_path_bvh_in(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
+                              uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow, PathState<T>& st,
+                              ShadowQuery<T>& q) {
   path_begin(s, c, pixel, sample, st);
   auto occlusion_test = [&](const ShadowQuery<T>& query) {  // query: q, filled just before
     ++n_shadow;
@@ -58,51 +55,6 @@ PB_HD Vec3f trace_path_one_ray_at_a_time(const SceneView& s, const BvhView& bvh,
     if (ev == PathEvent::Done) break;
   }
   return Vec3f(st.L);
-}
-
-// The paired loop: a vertex's shadow segment (q, pending) is traced together with the ray
-// that leaves the vertex (trace_pair, ray_pair.h): the closest-hit query for the next vertex,
-// or the last vertex's segment (qf). The segment's answer is added before the next vertex is
-// shaded, so the radiance is summed in the order of the loop above, bit for bit.
-template <uint32_t Kinds, class T, bool kWatertight, int kKind>
-PB_HD Vec3f trace_path_paired(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
-                              uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow, PathState<T>& st,
-                              ShadowQuery<T>& q) {
-  path_begin(s, c, pixel, sample, st);
-  ShadowQuery<T> qf;
-  bool pending = false, done = false;
-  for (;;) {
-    const bool final_vertex = !done && gpu_final_vertex(s, c, st);  // only emitted light can still count
-    const bool final_query = final_vertex && path_final_query<Kinds>(s, c, st, qf);
-    const SecondRay second =
-        done || final_vertex ? (final_query ? SecondRay::Shadow : SecondRay::None) : SecondRay::Closest;
-    if (!pending && second == SecondRay::None) break;
-    if (pending) ++n_shadow;
-    if (final_query) ++n_shadow;
-    if (second == SecondRay::Closest && st.depth > 0) ++n_bounce;  // the camera ray is counted per path
-    const PairAnswer a = trace_pair<kWatertight, kKind>(
-        bvh, pending, Vec3f(q.ray.o), Vec3f(q.ray.d), second, final_query ? Vec3f(qf.ray.o) : Vec3f(st.ray.o),
-        final_query ? Vec3f(qf.ray.d) : Vec3f(st.ray.d));
-    if (pending && !a.first_blocked) shadow_unoccluded(st, q);
-    if (second != SecondRay::Closest) {
-      if (final_query && a.hit == kNoHit) shadow_unoccluded(st, qf);
-      break;
-    }
-    if (a.hit == kNoHit) break;
-    const PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, a.hit, st.ray), q, pending);
-    done = ev == PathEvent::Done;
-  }
-  return Vec3f(st.L);
-}
-
-template <uint32_t Kinds, class T, bool kWatertight, int kKind>
-PB_HD Vec3f trace_path_bvh_in(const SceneView& s, const BvhView& bvh, const PathConfig& c, uint32_t pixel,
-                              uint32_t sample, uint32_t& n_bounce, uint32_t& n_shadow, PathState<T>& st,
-                              ShadowQuery<T>& q) {
-  if constexpr (kKind == int(TraversalKind::Binary) || kKind == kBinaryExactTies)
-    return trace_path_paired<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, sample, n_bounce, n_shadow, st, q);
-  else
-    return trace_path_one_ray_at_a_time<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, sample, n_bounce, n_shadow, st, q);
 }
 
 template <uint32_t Kinds, class T, bool kWatertight, int kKind>
