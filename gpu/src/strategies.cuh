@@ -47,8 +47,10 @@ struct PixelOccupancy {
   // The path state parked in shared memory (pixel.cu, ParkedPath) instead of registers.
   // PATHBENCH_GPU_PIXEL_PARKED=auto|0|1; auto: the leaves layout (at kLeavesParkedBlocks
   // unless PATHBENCH_GPU_PIXEL_BLOCKS says otherwise). 1 also parks the binary BVH's at 5
-  // and 8 blocks (paper-cornell-ico:8 at 8: 40.53 -> 39.93 ms; not yet the default: the
-  // other latency-bound scenes, whose L1 it shrinks, are not measured).
+  // and 8 blocks. Not the default there: measured at 8 on an H100 (docs/notes/gpu-log.md, "A
+  // vertex's shadow ray and the next ray in one walk"), 0.984-0.995 of the time in registers
+  // on the diffuse icospheres but 1.004 on large-mesh, 1.018 on bunny-armadillo and 1.045 on
+  // glass-dragon (it takes 205 KB of an SM's L1).
   bool parked = false;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
