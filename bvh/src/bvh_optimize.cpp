@@ -39,7 +39,10 @@ constexpr int kTreeletLeaves = 7;
 
 class Restructurer {
  public:
-  Restructurer(std::vector<BvhNode>& nodes, double ct, double ci) : n_(nodes), ct_(ct), ci_(ci), cost_(nodes.size()) {}
+  // The SAH's weights: tri_cost a triangle tested, node_cost a node visited (BvhBuildOptions'
+  // intersection_cost and traversal_cost).
+  Restructurer(std::vector<BvhNode>& nodes, double tri_cost, double node_cost)
+      : n_(nodes), tri_cost_(tri_cost), node_cost_(node_cost), cost_(nodes.size()) {}
 
   // One bottom-up pass; returns the tree's SAH cost (unnormalised) after it. The subtrees
   // below kCutDepth are passed in parallel (a treelet lies inside its root's subtree, so
@@ -60,7 +63,7 @@ class Restructurer {
  private:
   // A subtree's cost: a leaf's triangles, or a node's own cost and its children's.
   double ref_cost(uint32_t ref, const Box& b) const {
-    return is_leaf(ref) ? ct_ * sah_area(b) * leaf_count(ref) : cost_[ref];
+    return is_leaf(ref) ? tri_cost_ * sah_area(b) * leaf_count(ref) : cost_[ref];
   }
   void update_cost(uint32_t i) {
     const BvhNode& n = n_[i];
@@ -72,7 +75,7 @@ class Restructurer {
       u.grow(b);
       c += ref_cost(n.child[k], b);
     }
-    cost_[i] = c + ci_ * sah_area(u);
+    cost_[i] = c + node_cost_ * sah_area(u);
   }
 
   static constexpr uint32_t kCutDepth = 8, kNoLimit = ~0u;
@@ -158,7 +161,7 @@ class Restructurer {
         if (c < b) { b = c; bp = p; }
         if (s == 0) break;
       }
-      best_cost[m] = b + ci_ * area[m];
+      best_cost[m] = b + node_cost_ * area[m];
       split[m] = bp;
     }
     if (!(best_cost[full] < cost_[root] * (1.0 - 1e-9))) return;  // no gain: leave it
@@ -185,7 +188,7 @@ class Restructurer {
   }
 
   std::vector<BvhNode>& n_;
-  double ct_, ci_;
+  double tri_cost_, node_cost_;
   std::vector<double> cost_;
 };
 
