@@ -81,8 +81,12 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
 // a counter (work_chunks.cuh): more where traversals diverge (from kPixelLatencyBoundTris
 // triangle references on), where static shares end most unevenly. H100, interleaved
 // (results/nvidia-h100-80gb-hbm3/archive/work-chunks): paper-cornell 1 round 15.63 ms, 4 rounds
-// 16.15; ico:8 (100 spp) 1 round 8.30, 4 rounds 7.70 (grid stride alone: 8.87).
-constexpr uint32_t kWavefrontCounterRounds = 1, kWavefrontCounterRoundsLatencyBound = 4;
+// 16.15; ico:8 (100 spp) 1 round 8.30, 4 rounds 7.70 (grid stride alone: 8.87). With the
+// appends in one atomic (wavefront_state.cuh), no full round from the counter (only the
+// partial one) took paper-cornell's wavefront 11.19 -> 10.34 ms, 2048x2048x64 62.5 -> 57.3
+// and 128x128x16 0.129 -> 0.117; paper-queue and the meshes (4 rounds) unchanged
+// (results/nvidia-h100-80gb-hbm3/archive/wavefront-appends-408198e).
+constexpr uint32_t kWavefrontCounterRounds = 0, kWavefrontCounterRoundsLatencyBound = 4;
 
 // The pixel megakernel's counters on the device, zeroed before each frame: the stats,
 // and the next chunk of 32 samples to hand out (k_pixel takes its work from it).

@@ -106,10 +106,13 @@ __device__ __forceinline__ void trace_shadow_chunk(const BvhView& bvh, const Sha
     const float4 o = sh.o[i], d = sh.d[i];
     const float2 ct = sh.ct[i];
     const uint32_t target = __float_as_uint(ct.y);
+    const bool done = (target & kShadowDone) != 0;
+    // The radiance this ray adds to, loaded before the walk so that its latency hides behind
+    // it: a finished path's in the record, a continuing one's in `continued`.
+    float4 l = done ? sh.L[i] : continued.L[target];
     const Vec3f origin{o.x, o.y, o.z};
     const bool visible = !occluded<true, kKind>(bvh, origin, {d.x, d.y, d.z}, 1.0f);
-    if (target & kShadowDone) {
-      const float4 l = sh.L[i];
+    if (done) {
       L = {l.x, l.y, l.z};
       if (visible) L = L + Vec3f{o.w, d.w, ct.x};  // shadow_unoccluded: L += contribution
       if (l.w != 0.0f) {                             // a pair: the last vertex's emitter query
@@ -120,11 +123,10 @@ __device__ __forceinline__ void trace_shadow_chunk(const BvhView& bvh, const Sha
       add = true;
       pixel = target & ~kShadowDone;
     } else if (visible) {
-      float4 Lt = continued.L[target];
-      Lt.x = Lt.x + o.w;
-      Lt.y = Lt.y + d.w;
-      Lt.z = Lt.z + ct.x;
-      continued.L[target] = Lt;
+      l.x = l.x + o.w;
+      l.y = l.y + d.w;
+      l.z = l.z + ct.x;
+      continued.L[target] = l;
     }
   }
   film_add_warp<kVariance>(film, add, pixel, L, discarded);
@@ -192,61 +194,60 @@ __device__ __forceinline__ void push_shadow(const ShadowSoA& sh, uint32_t k, con
 }
 
 // One chunk of shade: paths [base, base + 32) of `cur` (n of them). All 32 lanes call it
-// (film_add_warp, the pair count).
+// (the appends, film_add_warp, the pair count). Returns the chunk's pairs (their second rays
+// are shadow rays the stats count), the same on every lane.
 template <bool kVariance, uint32_t Kinds>
-__device__ __forceinline__ void shade_chunk(const SceneView& s, const PathConfig& c, const PathSoA& cur,
+__device__ __forceinline__ uint32_t shade_chunk(const SceneView& s, const PathConfig& c, const PathSoA& cur,
                                             const PathSoA& next, const uint32_t* prim, const ShadowSoA& sh,
                                             WaveCounters* ctr, IterationCounters& at, const NewPaths& fresh,
                                             const FilmDev& film, uint32_t base, uint32_t n) {
-  const uint32_t lane = threadIdx.x & 31;
-  const uint32_t i = base + lane;
-  bool add = false, pair = false;
+  const uint32_t i = base + (threadIdx.x & 31);
+  bool add = false, cont = false, wants_shadow = false, final_ray = false;
   uint32_t pixel = 0;
   Vec3f L_add{0.0f, 0.0f, 0.0f};
+  PathState<float> st;
+  ShadowQuery<float> q, fq;
   if (i < n) {
-    PathState<float> st = current_path(s, c, cur, fresh, i);
+    st = current_path(s, c, cur, fresh, i);
     const uint32_t h = prim[i];
     pixel = st.pixel;
     if (h == kNoHit) {
       add = true;
       L_add = st.L;
     } else {
-      ShadowQuery<float> q, fq;
-      bool wants_shadow;
       PathEvent ev = path_hit<Kinds>(s, c, st, surface_hit(s, h, st.ray), q, wants_shadow);
       // The next vertex would be the last: answer it here (trace_path does the same
       // at the top of its loop), so the path never goes through trace + shade again.
-      bool final_ray = false;
       if (ev == PathEvent::Continue && gpu_final_vertex(s, c, st)) {
         final_ray = path_final_query<Kinds>(s, c, st, fq);
         ev = PathEvent::Done;
       }
-      uint32_t target = kShadowDone | st.pixel;
-      if (ev == PathEvent::Continue) {
-        const uint32_t j = queue_push(&at.n_next);
-        store_path(next, j, st);
-        target = j;
-      }
-      if (wants_shadow || final_ray) {
-        // Light-sampling ray first (shadow_unoccluded's order in trace_path); both
-        // rays of a pair leave from the same origin (the offset hit point).
-        const uint32_t k = queue_push(&at.n_shadow);
-        push_shadow(sh, k, wants_shadow ? q : fq, target);
-        pair = wants_shadow && final_ray;
-        if (pair) {
-          sh.d2[k] = make_float4(fq.ray.d.x, fq.ray.d.y, fq.ray.d.z, fq.contribution.x);
-          sh.c2[k] = make_float2(fq.contribution.y, fq.contribution.z);
-        }
-        if (target & kShadowDone) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, pair ? 1.0f : 0.0f);
-      } else if (ev == PathEvent::Done) {
+      cont = ev == PathEvent::Continue;
+      if (ev == PathEvent::Done && !wants_shadow && !final_ray) {
         add = true;
         L_add = st.L;
       }
     }
   }
+  const bool shadow = wants_shadow || final_ray;
+  const QueueSlots slot = queue_push_both(at, cont, shadow);
+  // Work that needs no slot, while the append's atomic is in flight.
   film_add_warp<kVariance>(film, add, pixel, L_add, &ctr->stats.discarded);
-  const uint32_t pairs = __reduce_add_sync(kFullMask, pair ? 1u : 0u);  // second rays of pairs
-  if (lane == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
+  const bool pair = wants_shadow && final_ray;
+  if (cont) store_path(next, slot.next, st);
+  if (shadow) {
+    // Light-sampling ray first (shadow_unoccluded's order in trace_path); both rays of a
+    // pair leave from the same origin (the offset hit point). A path that ended has its
+    // radiance in the record (kShadowDone | pixel); a continuing one, its slot in `next`.
+    const uint32_t k = slot.shadow;
+    push_shadow(sh, k, wants_shadow ? q : fq, cont ? slot.next : kShadowDone | st.pixel);
+    if (pair) {
+      sh.d2[k] = make_float4(fq.ray.d.x, fq.ray.d.y, fq.ray.d.z, fq.contribution.x);
+      sh.c2[k] = make_float2(fq.contribution.y, fq.contribution.z);
+    }
+    if (!cont) sh.L[k] = make_float4(st.L.x, st.L.y, st.L.z, pair ? 1.0f : 0.0f);
+  }
+  return __reduce_add_sync(kFullMask, pair ? 1u : 0u);
 }
 
 template <bool kVariance, uint32_t Kinds>
@@ -262,9 +263,11 @@ __global__ void __launch_bounds__(256, kShadeBlocksPerSm) k_wf_shade(SceneView s
     ctr->chunks.closest = 0;
   }
   const uint32_t end = (n + 31) / 32;
+  uint32_t pairs = 0;  // the warp's, booked once at the end: one atomic a warp, not one a chunk
   for_each_chunk(end, static_chunks(end, counter_rounds), &ctr->chunks.shade, [&](uint32_t k) {
-    shade_chunk<kVariance, Kinds>(s, c, cur, next, prim, sh, ctr, at, fresh, film, k * 32, n);
+    pairs += shade_chunk<kVariance, Kinds>(s, c, cur, next, prim, sh, ctr, at, fresh, film, k * 32, n);
   });
+  if ((threadIdx.x & 31) == 0 && pairs) atomicAdd(&ctr->stats.shadow, static_cast<unsigned long long>(pairs));
 }
 
 }  // namespace

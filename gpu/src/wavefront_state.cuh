@@ -5,9 +5,11 @@
 // queue append.
 #include <cuda_runtime.h>
 
+#include <cstddef>
 #include <cstdint>
 
 #include "device_film.cuh"
+#include "kernel_sync.h"
 #include "pathbench/common/path.h"
 
 namespace pb::gpu {
@@ -63,21 +65,40 @@ struct ChunkCounters {
   uint32_t shade;
 };
 
+// Each group on a 128-byte line of its own: the appends (it), the chunk claims and the stats'
+// atomics come from every warp at once, and one line takes them one after another.
 struct WaveCounters {
-  IterationCounters it[2];
-  Stats stats;  // booked by the planning thread, plus the kernels' atomics
-  ChunkCounters chunks;
+  alignas(128) IterationCounters it[2];
+  alignas(128) Stats stats;  // booked by the planning thread, plus the kernels' atomics
+  alignas(128) ChunkCounters chunks;
 };
 
-// Warp-aggregated append: one atomic per warp.
-__device__ __forceinline__ uint32_t queue_push(uint32_t* counter) {
-  const uint32_t mask = __activemask();
-  const uint32_t lane = threadIdx.x & 31;
-  const int leader = __ffs(mask) - 1;
-  uint32_t base = 0;
-  if (int(lane) == leader) base = atomicAdd(counter, uint32_t(__popc(mask)));
-  base = __shfl_sync(mask, base, leader);
-  return base + uint32_t(__popc(mask & ((1u << lane) - 1u)));
+// n_next and n_shadow are one 8-byte word to the appends (queue_push_both).
+static_assert(offsetof(IterationCounters, n_shadow) == offsetof(IterationCounters, n_next) + 4 &&
+                  offsetof(IterationCounters, n_next) % 8 == 0,
+              "n_next and n_shadow: one aligned 64-bit word, n_next the low half");
+
+// Where a lane's appends go: its slot in the next buffer and in the shadow queue (each
+// meaningful only where the lane appended there).
+struct QueueSlots {
+  uint32_t next, shadow;
+};
+
+// Warp-aggregated appends to both of an iteration's queues with one atomic: a 64-bit add of
+// (shadow rays << 32 | paths) to the word n_next and n_shadow make (n_next < 2^32 cannot carry
+// into n_shadow). Every shade chunk appends to both, and all warps append to this one word:
+// as two 32-bit atomics their results were 48 % of k_wf_shade's stall samples (Nsight Compute,
+// H100, paper-cornell; docs/notes/gpu-log.md). All 32 lanes call it.
+__device__ __forceinline__ QueueSlots queue_push_both(IterationCounters& at, bool next, bool shadow) {
+  const uint32_t lane = threadIdx.x & 31, below = (1u << lane) - 1u;
+  const uint32_t m_next = __ballot_sync(kFullMask, next), m_shadow = __ballot_sync(kFullMask, shadow);
+  unsigned long long base = 0;
+  if (lane == 0 && (m_next | m_shadow) != 0u) {
+    const unsigned long long add = (static_cast<unsigned long long>(__popc(m_shadow)) << 32) | uint32_t(__popc(m_next));
+    base = atomicAdd(reinterpret_cast<unsigned long long*>(&at.n_next), add);
+  }
+  base = __shfl_sync(kFullMask, base, 0);
+  return {uint32_t(base) + uint32_t(__popc(m_next & below)), uint32_t(base >> 32) + uint32_t(__popc(m_shadow & below))};
 }
 
 __device__ __forceinline__ PathState<float> load_path(const PathSoA& p, uint32_t i) {

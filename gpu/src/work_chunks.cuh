@@ -7,7 +7,8 @@
 // Measured on an H100 (docs/notes/gpu-log.md, "Work from a counter"): the megakernel all from the
 // counter, paper-cornell 12.00 -> 11.58 ms, ico:8 48.6 -> 43.0; the wavefront's stages
 // with the last full round and the partial one from it, paper-cornell unchanged, ico:8 -6 %;
-// with the last 4, ico:8 -14 %, paper-cornell +3.5 % (strategies.cuh, kWavefrontCounterRounds).
+// with the last 4, ico:8 -14 %, paper-cornell +3.5 %; today the meshes take 4 and the rest
+// only the partial round (strategies.cuh, kWavefrontCounterRounds).
 #include <cuda_runtime.h>
 
 #include <cstdint>
