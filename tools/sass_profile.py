@@ -6,9 +6,12 @@ Reads the CSV that `ncu -i REPORT --page source --csv --print-source sass` write
 e.g. the launch's samples divided by 32, for warp instructions per warp of samples):
   - the executed warp instructions and the sampled warp stalls by opcode,
   - the hottest straight-line blocks (runs of instructions with one execution count),
-    with their first instruction, so a block can be found in the disassembly.
+    with their first instruction, so a block can be found in the disassembly;
+  - with --stalls N: the stall samples by reason, and the N instructions with the most
+    stall samples, each with its two largest reasons (where a kernel waits, and on what:
+    e.g. long_sb on the instruction that first uses a load's or an atomic's result).
 
-  tools/sass_profile.py pixel-sass.csv[.gz] --per 2048 [--top 25]
+  tools/sass_profile.py pixel-sass.csv[.gz] --per 2048 [--top 25] [--stalls 12]
 """
 import argparse
 import collections
@@ -16,10 +19,11 @@ import csv
 import gzip
 import re
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 STALL_COLUMN = "Warp Stall Sampling (All Samples)"
+REASON_PREFIX = "stall_"  # the per-reason sample columns (ncu names "stall_long_sb", ...)
 
 
 @dataclass
@@ -27,6 +31,7 @@ class Instruction:
     text: str        # the SASS line, predicate guard included
     executed: float  # warp-level executions in the profiled launch
     stalls: float    # sampled warp stalls at this instruction (0 where not sampled)
+    reasons: dict = field(default_factory=dict)  # {reason: samples}, nonzero ones only
 
 
 @dataclass
@@ -67,13 +72,17 @@ def read_instructions(path):
                          "(not the CSV of ncu --page source --print-source sass?)")
     src, ex = hdr.index("Source"), hdr.index("Instructions Executed")
     st = hdr.index(STALL_COLUMN) if STALL_COLUMN in hdr else None
+    # All samples per reason; ncu adds a "(Not Issued)" twin of each, left out here.
+    reason_cols = [(i, h[len(REASON_PREFIX):]) for i, h in enumerate(hdr)
+                   if h.startswith(REASON_PREFIX) and "Not Issued" not in h]
     out = []
     for r in body:
         if len(r) <= max(src, ex):
             continue
         try:
             stalls = float(r[st] or 0) if st is not None and len(r) > st else 0.0
-            out.append(Instruction(r[src].strip(), float(r[ex] or 0), stalls))
+            reasons = {name: float(r[i]) for i, name in reason_cols if i < len(r) and r[i] and float(r[i])}
+            out.append(Instruction(r[src].strip(), float(r[ex] or 0), stalls, reasons))
         except ValueError as e:
             raise ValueError(f"{path}: a count that is not a number ({e})") from e
     return out
@@ -123,18 +132,48 @@ def report(instructions, per=1.0, top=25):
     return "\n".join(lines)
 
 
+def stall_report(instructions, top=12):
+    """The stall samples by reason, then the `top` instructions with the most samples (their
+    index in address order, share, executions, text and two largest reasons)."""
+    total = sum(i.stalls for i in instructions)
+    if total == 0:
+        raise ValueError("no stall samples (was the SourceCounters section collected?)")
+    by_reason = collections.Counter()
+    for ins in instructions:
+        by_reason.update(ins.reasons)
+    lines = [f"{total:.0f} stall samples; by reason: " +
+             ", ".join(f"{r} {n / total * 100:.1f} %" for r, n in by_reason.most_common(8)), "",
+             f"{'index':>6s} {'stall %':>7s} {'executed':>10s}  {'instruction':60s} reasons"]
+    worst = sorted(range(len(instructions)), key=lambda k: -instructions[k].stalls)[:top]
+    for k in sorted(worst):
+        ins = instructions[k]
+        if ins.stalls == 0:
+            continue
+        why = ", ".join(f"{r} {n:.0f}" for r, n in collections.Counter(ins.reasons).most_common(2))
+        lines.append(f"{k:6d} {ins.stalls / total * 100:7.1f} {ins.executed:10.0f}  {ins.text[:60]:60s} {why}")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("csv")
     ap.add_argument("--per", type=float, default=1.0, help="divide counts by this (units of work in the launch)")
     ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--stalls", type=int, default=0, metavar="N",
+                    help="also the stall samples by reason and the N most stalled instructions")
     a = ap.parse_args(argv)
     if not a.per > 0:
         ap.error("--per must be positive")
     if a.top < 1:
         ap.error("--top must be at least 1")
+    if a.stalls < 0:
+        ap.error("--stalls must not be negative")
     try:
-        print(report(read_instructions(a.csv), a.per, a.top))
+        instructions = read_instructions(a.csv)
+        print(report(instructions, a.per, a.top))
+        if a.stalls:
+            print()
+            print(stall_report(instructions, a.stalls))
     except (OSError, ValueError) as e:
         print(f"sass_profile: {e}", file=sys.stderr)
         return 2

@@ -12,9 +12,17 @@
 # (a render's first launch is its warm-up frame, one sample a pixel, whose warps span 32
 # pixels; the bench's is its warm-up): the counts are per launch (pixel: 256x256 x SPP
 # samples; ray casts: the bench's stored rays). SKIP=0 profiles the first launch instead.
+# With NAME KERNEL_REGEX -- COMMAND... after OUT_DIR, it profiles that one kernel of that
+# command instead (e.g. k_wf_shade of a wavefront render, SKIP=21: a launch mid-frame), and
+# tools/sass_profile.py then writes NAME-profile.txt (by opcode, hot blocks, and the most
+# stalled instructions with their reasons).
+#   scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR [NAME KERNEL_REGEX -- COMMAND...]
 set -uo pipefail
-build=${1:?usage: scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
-out=${2:?usage: scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR}
+usage="usage: scripts/device/gpu_sass_profile.sh BUILD_DIR OUT_DIR [NAME KERNEL_REGEX -- COMMAND...]"
+build=${1:?$usage}
+out=${2:?$usage}
+shift 2
+if [ $# -gt 0 ] && { [ $# -lt 4 ] || [ "$3" != "--" ]; }; then echo "$usage" >&2; exit 2; fi
 spp=${SPP:-16}
 mkdir -p "$out"
 sections=(--section SourceCounters --section WarpStateStats --section InstructionStats --section LaunchStats
@@ -30,7 +38,16 @@ profile() {  # name, kernel regex, then the command
   echo "sass page rc=$? $(wc -l < "$out/$name-sass.csv") lines"
   ncu -i "$out/$name.ncu-rep" --page details --csv > "$out/$name-details.csv" 2> "$out/$name-details.err"
   echo "details rc=$? $(wc -l < "$out/$name-details.csv") lines"
+  python3 "$(dirname "${BASH_SOURCE[0]}")/../../tools/sass_profile.py" "$out/$name-sass.csv" --top 30 --stalls 20 \
+    > "$out/$name-profile.txt" 2>&1
+  echo "sass_profile rc=$?"
 }
+if [ $# -gt 0 ]; then  # one kernel of the caller's command
+  name=$1 kernel=$2
+  shift 3
+  profile "$name" "$kernel" "$@"
+  exit 0
+fi
 profile pixel k_pixel "$build/bin/pathbench" render --device gpu --quiet --scene paper-cornell --width 256 --height 256 \
   --spp "$spp" --bounces 2 --sampling nee --strategy pixel
 profile raycast k_trace "$build/bin/pathbench-bench" --preset paper \

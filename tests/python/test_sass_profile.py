@@ -83,8 +83,37 @@ def test_refuses_special_files_without_reading_them(tmp_path, capsys):
         assert "not a regular file" in capsys.readouterr().err
 
 
+def test_stalls_by_reason_and_instruction(tmp_path, capsys):
+    # ncu's per-reason columns, each with a "(Not Issued)" twin that is not counted again
+    header = HEADER + ['"stall_long_sb"', '"stall_wait"', '"stall_long_sb (Not Issued)"']
+    rows = [("0x0", "LDG.E R3, desc[UR4][R2.64]", 2, 100, 3200, 0, 2, 0),
+            ("0x10", "ISETP.NE.AND P0, PT, R3, -0x1, PT", 60, 100, 3200, 58, 2, 58),
+            ("0x20", "ATOMG.E.ADD.64 PT, R8, desc[UR4][R2.64], R6", 0, 100, 100, 0, 0, 0),
+            ("0x30", "SHFL.IDX PT, R9, R8, RZ, 0x1f", 38, 100, 3200, 30, 8, 30)]
+    p = tmp_path / "stalls-sass.csv"
+    p.write_text("\n".join(['"Kernel Name","k_test(int)"', ",".join(header)] +
+                           [",".join(f'"{c}"' for c in r) for r in rows]) + "\n")
+    ins = sass_profile.read_instructions(p)
+    assert ins[1].reasons == {"long_sb": 58, "wait": 2} and ins[2].reasons == {}
+    text = sass_profile.stall_report(ins, top=2)
+    assert "100 stall samples; by reason: long_sb 88.0 %, wait 12.0 %" in text
+    body = text.splitlines()[3:]
+    assert len(body) == 2  # the two most stalled, in address order
+    assert body[0].split()[:3] == ["1", "60.0", "100"] and body[0].endswith("long_sb 58, wait 2")
+    assert body[1].split()[:3] == ["3", "38.0", "100"] and "SHFL.IDX" in body[1]
+    assert sass_profile.main([str(p), "--stalls", "1"]) == 0
+    assert "ISETP.NE.AND" in capsys.readouterr().out.split("by reason")[1]
+
+
+def test_stalls_without_samples_are_an_error(profile, tmp_path, capsys):
+    p = tmp_path / "nostall-sass.csv"
+    write_csv(p, [("0x0", "NOP", 0, 10, 320)])
+    assert sass_profile.main([str(p), "--stalls", "3"]) == 2
+    assert "no stall samples" in capsys.readouterr().err
+
+
 def test_refuses_bad_options(profile):
-    for args in (["--per", "0"], ["--per", "nan"], ["--top", "0"]):
+    for args in (["--per", "0"], ["--per", "nan"], ["--top", "0"], ["--stalls", "-1"]):
         with pytest.raises(SystemExit) as e:
             sass_profile.main([str(profile), *args])
         assert e.value.code == 2
