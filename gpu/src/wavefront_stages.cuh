@@ -208,8 +208,9 @@ __device__ __forceinline__ uint32_t shade_chunk(const SceneView& s, const PathCo
   PathState<float> st;
   ShadowQuery<float> q, fq;
   if (i < n) {
-    st = current_path(s, c, cur, fresh, i);
+    // The hit first: its load then waits while a new path's camera ray is made.
     const uint32_t h = prim[i];
+    st = current_path(s, c, cur, fresh, i);
     pixel = st.pixel;
     if (h == kNoHit) {
       add = true;
