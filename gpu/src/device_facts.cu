@@ -137,6 +137,7 @@ DeviceInfo device_info() {
   info.compute_minor = prop.minor;
   info.multiprocessors = prop.multiProcessorCount;
   info.total_memory = prop.totalGlobalMem;
+  info.l2_bytes = uint64_t(prop.l2CacheSize);
   PB_CUDA_CHECK(cudaDriverGetVersion(&info.driver_version));
   PB_CUDA_CHECK(cudaRuntimeGetVersion(&info.runtime_version));
   info.slug = pb::slugify(info.name, "unknown-gpu");

@@ -89,19 +89,28 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
 
 // The counts k_pixel is compiled for (float, watertight): 3 and kPixelLatencyBlocks for every
 // layout, 5 too for the wide, leaves, rects and binary layouts (kWideLatencyBlocks,
-// kLeavesParkedBlocks, the binary BVH's opt-in); the parked path state for the leaves layout
-// at every count but kPixelLatencyBlocks and the binary BVH's at 5 and 8. run_pixel
+// kLeavesParkedBlocks, the binary BVH's opt-in), 6 for the binary layout (kPixelBigBvhBlocks);
+// the parked path state for the leaves layout at every count but kPixelLatencyBlocks and the
+// binary BVH's at 5, 6 and 8. run_pixel
 // dispatches on these, pixel_blocks and pixel_occupancy choose within them.
 constexpr bool compiled_for_five_blocks(int kind) {
   return kind == int(TraversalKind::Wide) || kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Binary) ||
          kind == int(TraversalKind::Rects);
 }
+constexpr bool compiled_for_six_blocks(int kind) { return kind == int(TraversalKind::Binary); }
 constexpr bool parked_compiled(int kind, int blocks) {
   return ((kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Rects)) && blocks != kPixelLatencyBlocks) ||
          (kind == int(TraversalKind::Binary) && blocks >= 5);
 }
-static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kPixelLatencyBlocks == 8,
-              "the counts compiled: 3, 5 and 8");
+static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kPixelLatencyBlocks == 8 && kPixelBigBvhBlocks == 6,
+              "the counts compiled: 3, 5 and 8, and 6 for the binary BVH");
+
+// The scene's BVH exceeds the device's L2 (the binary layout's nodes and triangles): auto
+// runs its megakernel at kPixelBigBvhBlocks with the path state parked (strategies.cuh).
+bool big_binary_bvh(const GpuScene::Impl& g) {
+  if (g.bvh.kind != TraversalKind::Binary || g.bvh.binary.exact_ties) return false;
+  return g.bvh_bytes > device_info().l2_bytes;
+}
 
 // The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy).
 PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
@@ -111,13 +120,17 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
   const std::string v = env ? env : "auto";
   if (v != "auto") {
     const bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) ||
-                    (compiled_for_five_blocks(int(g.bvh.kind)) && v == "5");
+                    (compiled_for_five_blocks(int(g.bvh.kind)) && v == "5") ||
+                    (compiled_for_six_blocks(int(g.bvh.kind)) && v == std::to_string(kPixelBigBvhBlocks));
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
-                                   "auto, 3, 5 or 8; the leaves, rects and binary layouts: also 5)", v,
-                                   kPixelLatencyBlocks));
+                                   "auto, 3, 5 or 8; the leaves and rects layouts: also 5; the binary layout: also 5 "
+                                   "and {})", v, kPixelLatencyBlocks, kPixelBigBvhBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }
+  if (big_binary_bvh(g))
+    return {kPixelBigBvhBlocks, fmt::format("auto: the binary BVH's {:.1f} MB exceed the L2 ({} blocks, the path state "
+                                            "parked)", double(g.bvh_bytes) / 1e6, kPixelBigBvhBlocks)};
   if (g.bvh_tris >= kPixelLatencyBoundTris)
     return {latency, fmt::format("auto: {} triangles >= {} (latency bound: more warps{})", g.bvh_tris,
                                  kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
@@ -130,7 +143,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
   const std::string v = env ? env : "auto";
-  if (v == "auto") o.parked = leaves;
+  if (v == "auto") o.parked = leaves || (o.min_blocks == kPixelBigBvhBlocks && big_binary_bvh(g));
   else if (v == "0" || v == "1") o.parked = v == "1";
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
   if (o.parked && !parked_compiled(int(g.bvh.kind), o.min_blocks)) o.parked = false;
@@ -138,7 +151,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
     o.min_blocks = kLeavesParkedBlocks;
     o.why = fmt::format("auto: the leaves layout, its path state parked: {} blocks", kLeavesParkedBlocks);
-  } else if (o.parked) {
+  } else if (o.parked && o.why.find("parked") == std::string::npos) {
     o.why += "; path state parked in shared memory";
   }
   return o;
@@ -174,6 +187,9 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
         };
         if constexpr (compiled_for_five_blocks(B)) {
           if (min_blocks == 5) return at(std::integral_constant<int, 5>{});
+        }
+        if constexpr (compiled_for_six_blocks(B)) {
+          if (min_blocks == kPixelBigBvhBlocks) return at(std::integral_constant<int, kPixelBigBvhBlocks>{});
         }
         if (min_blocks == kPixelLatencyBlocks) at(std::integral_constant<int, kPixelLatencyBlocks>{});
         else at(std::integral_constant<int, 3>{});

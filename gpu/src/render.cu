@@ -329,6 +329,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
               {"compute_capability", fmt::format("{}.{}", info.compute_major, info.compute_minor)},
               {"multiprocessors", info.multiprocessors},
               {"memory_bytes", info.total_memory},
+              {"l2_bytes", info.l2_bytes},
               {"driver_version", su.driver},
               {"driver_cuda_version", fmt::format("{}.{}", info.driver_version / 1000, (info.driver_version % 1000) / 10)},
               {"cuda_runtime_version", fmt::format("{}.{}", info.runtime_version / 1000, (info.runtime_version % 1000) / 10)},
@@ -338,7 +339,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
   x["film_device_bytes"] = su.fb.bytes();
   x["scene_device_bytes"] = g.bytes;
   x["bvh"] = {{"layout", to_string(g.layout)}, {"nodes", g.bvh_nodes}, {"node_bytes", g.bvh_node_bytes},
-              {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth},
+              {"triangle_refs", g.bvh_tris}, {"leaves", g.bvh_leaves}, {"depth", g.bvh_depth}, {"device_bytes", g.bvh_bytes},
               {"sah_cost", g.bvh_sah}, {"build_seconds", g.bvh_build_seconds}, {"treelet_passes", g.bvh_treelet_passes},
               {"builder", g.layout == GpuBvhLayout::Brute ? "none: every triangle tested"
                           : g.layout == GpuBvhLayout::Binary ? "embree rtcBuildBVH, binned SAH, binary"

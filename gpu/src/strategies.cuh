@@ -39,18 +39,20 @@ struct ShadowUse {
 // The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
 // and the megakernel waits on memory (more warps hide it); below, it is issue bound.
-// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 (5 too for the leaves and binary layouts) overrides it (a bad value: InputError); the wide
-// BVH's megakernel is compiled for 5 too (pixel.cu: compiled_for_five_blocks).
+// PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 (5 too for the leaves and binary layouts, 6 for the binary)
+// overrides it (a bad value: InputError); the wide BVH's megakernel is compiled for 5 too
+// (pixel.cu: compiled_for_five_blocks).
 struct PixelOccupancy {
   int min_blocks = 3;
   std::string why;
   // The path state parked in shared memory (pixel.cu, ParkedPath) instead of registers.
   // PATHBENCH_GPU_PIXEL_PARKED=auto|0|1; auto: the leaves layout (at kLeavesParkedBlocks
-  // unless PATHBENCH_GPU_PIXEL_BLOCKS says otherwise). 1 also parks the binary BVH's at 5
-  // and 8 blocks. Not the default there: measured at 8 on an H100 (docs/notes/gpu-log.md, "A
-  // vertex's shadow ray and the next ray in one walk"), 0.984-0.995 of the time in registers
-  // on the diffuse icospheres but 1.004 on large-mesh, 1.018 on bunny-armadillo and 1.045 on
-  // glass-dragon (it takes 205 KB of an SM's L1).
+  // unless PATHBENCH_GPU_PIXEL_BLOCKS says otherwise), and a binary BVH larger than the L2 at
+  // kPixelBigBvhBlocks. 1 also parks the binary BVH's at 5, 6 and 8 blocks. Not the default at 8:
+  // measured on an H100 (docs/notes/gpu-log.md, "A vertex's shadow ray and the next ray in one
+  // walk"), 0.984-0.995 of the time in registers on the diffuse icospheres but 1.004 on
+  // large-mesh, 1.018 on bunny-armadillo and 1.045 on glass-dragon (it takes 205 KB of an
+  // SM's L1).
   bool parked = false;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
@@ -59,6 +61,14 @@ constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // (48 registers): ico:5 35.81 -> 35.69 ms, ico:7 43.12 -> 42.92, ico:8 49.08 -> 47.96
 // (256x256x800 nee; 4 and 6 blocks in between; results/nvidia-h200/archive/pixel-occupancy-8).
 constexpr int kPixelLatencyBlocks = 8;
+// A binary BVH larger than the device's L2 (its nodes and triangles: GpuScene::Impl::bvh_bytes)
+// gets 6 blocks (40 registers) with the path state parked: its node loads miss L2, and at 8
+// blocks the spills of the path state (32 registers) compete with them for L2. H100 (50 MB of
+// L2), 256x256x800 nee, interleaved against 8 blocks in registers, the same films
+// (docs/notes/gpu-log.md, "The big BVHs' megakernel at 6 blocks, parked"): ico:8 (111 MB)
+// 0.968, large-mesh (1.1 GB) 0.977; below the L2 it did not pay, bunny-armadillo (11 MB) 1.008,
+// glass-dragon (16 MB) 0.994, so those keep 8.
+constexpr int kPixelBigBvhBlocks = 6;
 // The wide BVH's megakernel holds a node's 20 words and the ray's slab constants across its
 // child tests: at 8 blocks (32 registers) it spills them. It gets a count of its own for
 // latency-bound scenes, kWideLatencyBlocks (at most 48 registers): on an H100,

@@ -179,7 +179,7 @@ TEST(GpuWavefrontPools, BitIdenticalForAnyPoolCount) {
 
 // The megakernel's path state parked in shared memory (PATHBENCH_GPU_PIXEL_PARKED; auto: the
 // leaves layout) or kept in registers: the same arithmetic, so the same film bit for bit, on
-// the leaves layout (paper-cornell) and on the binary BVH at 5 and 8 blocks (ico:3, binary by
+// the leaves layout (paper-cornell) and on the binary BVH at 5, 6 and 8 blocks (ico:3, binary by
 // name); the report says which ran. A value the variable cannot mean is an InputError naming it.
 TEST(GpuPixelParked, SameFilmAsInRegisters) {
   PB_REQUIRE_GPU();
@@ -208,7 +208,7 @@ TEST(GpuPixelParked, SameFilmAsInRegisters) {
     ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
     const Film in_registers = render_gpu(scene, gs, s);
     ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "1", 1);
-    for (const char* blocks : {"5", "8"}) {
+    for (const char* blocks : {"5", "6", "8"}) {
       ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", blocks, 1);
       RunReport r;
       const std::string what = std::string("binary: parked at ") + blocks + " blocks";
@@ -221,6 +221,35 @@ TEST(GpuPixelParked, SameFilmAsInRegisters) {
   }
   ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
   ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+}
+
+// auto's occupancy for the binary BVH from kPixelLatencyBoundTris triangles on: 8 blocks with the
+// path state in registers while the BVH fits the device's L2 (ico:5, ~2 MB), kPixelBigBvhBlocks
+// with it parked beyond (ico:8, ~111 MB: more than any current GPU's L2); the report names
+// the sizes compared, and the film is the one 8 blocks in registers give.
+TEST(GpuPixelOccupancy, BigBinaryBvhParkedAtSixBlocks) {
+  PB_REQUIRE_GPU();
+  ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
+  ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  const RenderSettings s = small_settings(Strategy::Pixel, 32, 32);
+  for (const char* name : {"paper-cornell-ico:5", "paper-cornell-ico:8"}) {
+    const Scene scene = load_scene(name);
+    const GpuScene gs(scene);
+    RunReport r;
+    const Film film = render_gpu(scene, gs, s, &r);
+    const auto& occ = r.extra["pixel_occupancy"];
+    const bool big = r.extra["bvh"]["device_bytes"].get<uint64_t>() > r.extra["gpu"]["l2_bytes"].get<uint64_t>();
+    EXPECT_EQ(r.extra["bvh"]["layout"], "binary") << name;
+    EXPECT_EQ(big, std::string(name) == "paper-cornell-ico:8") << name << ": " << r.extra["bvh"]["device_bytes"];
+    EXPECT_EQ(occ["min_blocks_per_sm"], big ? 6 : 8) << name << ": " << occ["why"];
+    EXPECT_EQ(occ["parked_path_state"], big) << name << ": " << occ["why"];
+    ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", "8", 1);
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "0", 1);
+    expect_identical(film, render_gpu(scene, gs, s, &r), name);
+    EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], 8) << name;
+    ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
+    ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  }
 }
 
 // GPU against the CPU tracer, same seed and settings: with one random stream the

@@ -32,6 +32,7 @@ struct DeviceInfo {
   int compute_major = 0, compute_minor = 0;
   int multiprocessors = 0;
   uint64_t total_memory = 0;
+  uint64_t l2_bytes = 0;     // the L2 cache (the pixel megakernel's occupancy rule reads it)
   int driver_version = 0;   // e.g. 13000
   int runtime_version = 0;
   std::string slug;         // results/<slug>/: "nvidia-h100-80gb-hbm3"
