@@ -205,7 +205,9 @@ EnergyMeter::EnergyMeter(Device device) : impl_(std::make_unique<Impl>()) {
     s.domains = rapl_domains(s.why_not);
     for (const auto& d : s.domains) {
       uint64_t v = 0;
-      read_u64(d.file, v, nullptr);
+      // A start that cannot be read gives no figure (null with the reason), never one
+      // counted from 0.
+      if (!read_u64(d.file, v, &s.why_not)) break;
       s.start_uj.push_back(v);
     }
   } else {
