@@ -11,87 +11,88 @@ import pytest
 from test_suite import PATHBENCH, needs_build, strict_load
 
 
-@needs_build
-def test_render_report_energy_null_with_reason_and_rapl_wrap(tmp_path):
-    """No powercap here: energy null with the reason. A fake powercap tree whose counter
-    wraps: the joules are the wrapped difference, never negative."""
+def render_energy(tmp_path, powercap_root):
+    """A small CPU render with RAPL read under `powercap_root`; its report's energy record."""
     out = tmp_path / "r.json"
-    base = [str(PATHBENCH), "render", "--scene", "paper-cornell", "--width", "16", "--height", "16", "--spp", "2",
+    args = [str(PATHBENCH), "render", "--scene", "paper-cornell", "--width", "16", "--height", "16", "--spp", "2",
             "--report", str(out)]
-    env = dict(os.environ, PATHBENCH_POWERCAP_ROOT=str(tmp_path / "none"))
-    r = subprocess.run(base, capture_output=True, text=True, env=env)
+    r = subprocess.run(args, capture_output=True, text=True, timeout=60,
+                       env=dict(os.environ, PATHBENCH_POWERCAP_ROOT=str(powercap_root)))
     assert r.returncode == 0, r.stderr
-    e = strict_load(out)["energy"]
-    assert e["joules"] is None and "does not exist" in e["reason"] and e["source"] == "rapl"
-    # A counter that reads near its maximum and is not advancing: 0 J, not "max_range" J.
-    fake = tmp_path / "powercap" / "intel-rapl:0"
-    fake.mkdir(parents=True)
-    (fake / "energy_uj").write_text("999990\n")
-    (fake / "max_energy_range_uj").write_text("1000000\n")
-    (fake / "name").write_text("package-0\n")
-    (tmp_path / "powercap" / "intel-rapl:0:0").mkdir()  # a sub-zone (core, dram): not counted
-    env["PATHBENCH_POWERCAP_ROOT"] = str(tmp_path / "powercap")
-    r = subprocess.run(base, capture_output=True, text=True, env=env)
-    assert r.returncode == 0, r.stderr
-    e = strict_load(out)["energy"]
-    assert e["joules"] == 0 and e["rays_per_joule"] is None
-    # A counter readable at the probe but not at the start (a FIFO that hands out one value,
-    # then closes with none): no figure, the file named, never joules counted from 0.
-    zone = tmp_path / "powercap-no-start" / "intel-rapl:0"
+    report = strict_load(out)
+    return report["energy"], report["rays"]["total"]
+
+
+def fifo_zone(root):
+    """A fake package domain under `root` whose energy_uj is a FIFO."""
+    zone = root / "intel-rapl:0"
     zone.mkdir(parents=True)
     (zone / "max_energy_range_uj").write_text("1000000\n")
+    (zone / "name").write_text("package-0\n")
     os.mkfifo(zone / "energy_uj")
+    return zone / "energy_uj"
 
-    def feed_once(fifo=zone / "energy_uj"):
+
+def feed(fifo, values):
+    """Hands `values` to the FIFO's readers, one per open, pausing so that a reader closes before
+    the next open (on a loaded machine it may not: the tests below allow for it)."""
+    def run():
         try:
-            for v in ("999990\n", ""):
+            for v in values:
                 with open(fifo, "w") as f:
                     f.write(v)
                 time.sleep(1.5)
-        except BrokenPipeError:
+        except BrokenPipeError:  # released by release() after a render that read out of step
             pass
-    t = threading.Thread(target=feed_once, daemon=True)
+    t = threading.Thread(target=run, daemon=True)
     t.start()
-    env["PATHBENCH_POWERCAP_ROOT"] = str(zone.parent)
-    r = subprocess.run(base, capture_output=True, text=True, env=env, timeout=60)
-    assert r.returncode == 0, r.stderr
-    e = strict_load(out)["energy"]
-    assert e["joules"] is None and "energy_uj: not a number" in e["reason"] and e.get("rays_per_joule") is None, e
-    os.close(os.open(zone / "energy_uj", os.O_RDONLY | os.O_NONBLOCK))  # frees the feeder if it waits
-    t.join(5)
-    # The counter wraps during the render: a FIFO hands out 999990 (the probe), 999990 (start)
-    # and then 10 (end): 20 uJ, not a negative or a 1 J figure. The feeder's timing is not the
-    # reader's: on a loaded machine a read can meet the last value's writer still open, and
-    # then sees no number. Such a read must give no figure (null, naming the file), never one
-    # counted from 0; the run is tried again, up to three times, for the 20 uJ.
-    for attempt in range(3):
-        zone = tmp_path / f"powercap-{attempt}" / "intel-rapl:0"
-        zone.mkdir(parents=True)
-        (zone / "max_energy_range_uj").write_text("1000000\n")
-        (zone / "name").write_text("package-0\n")
-        os.mkfifo(zone / "energy_uj")
+    return t
 
-        def feed(fifo=zone / "energy_uj"):  # one value per open; the pause lets the reader close
-            try:
-                for v in ("999990", "999990", "10"):
-                    with open(fifo, "w") as f:
-                        f.write(v + "\n")
-                    time.sleep(1.5)
-            except BrokenPipeError:  # released below after a run that read out of step
-                pass
-        t = threading.Thread(target=feed, daemon=True)
-        t.start()
-        env["PATHBENCH_POWERCAP_ROOT"] = str(zone.parent)
-        r = subprocess.run(base, capture_output=True, text=True, env=env, timeout=60)
-        assert r.returncode == 0, r.stderr
-        e = strict_load(out)["energy"]
+
+def release(fifo, feeder):
+    os.close(os.open(fifo, os.O_RDONLY | os.O_NONBLOCK))  # frees a feeder left waiting for a reader
+    feeder.join(5)
+
+
+@needs_build
+def test_energy_null_without_rapl_and_zero_for_a_still_counter(tmp_path):
+    e, _ = render_energy(tmp_path, tmp_path / "none")
+    assert e["joules"] is None and "does not exist" in e["reason"] and e["source"] == "rapl"
+    # A counter that reads near its maximum and is not advancing: 0 J, not "max_range" J.
+    zone = tmp_path / "powercap" / "intel-rapl:0"
+    zone.mkdir(parents=True)
+    (zone / "energy_uj").write_text("999990\n")
+    (zone / "max_energy_range_uj").write_text("1000000\n")
+    (zone / "name").write_text("package-0\n")
+    (tmp_path / "powercap" / "intel-rapl:0:0").mkdir()  # a sub-zone (core, dram): not counted
+    e, _ = render_energy(tmp_path, tmp_path / "powercap")
+    assert e["joules"] == 0 and e["rays_per_joule"] is None
+
+
+@needs_build
+def test_energy_null_when_the_start_reads_no_number(tmp_path):
+    """A counter readable at the probe but not at the start (the FIFO closes with nothing): no
+    figure, the file named, never joules counted from 0."""
+    fifo = fifo_zone(tmp_path / "powercap")
+    feeder = feed(fifo, ["999990\n", ""])
+    e, _ = render_energy(tmp_path, tmp_path / "powercap")
+    release(fifo, feeder)
+    assert e["joules"] is None and "energy_uj: not a number" in e["reason"] and e.get("rays_per_joule") is None, e
+
+
+@needs_build
+def test_energy_counts_across_the_counters_wrap(tmp_path):
+    """The counter wraps during the render: 999990 (the probe), 999990 (start), then 10 (end) give
+    20 uJ, not a negative or a 1 J figure. A render whose reads met the FIFO out of step must
+    report null with the reason (never a figure); it is tried again, up to three times."""
+    for attempt in range(3):
+        fifo = fifo_zone(tmp_path / f"powercap-{attempt}")
+        feeder = feed(fifo, ["999990\n", "999990\n", "10\n"])
+        e, rays = render_energy(tmp_path, fifo.parent.parent)
+        release(fifo, feeder)
         if e["joules"] is not None:
             assert e["joules"] == pytest.approx(20e-6) and e["source"] == "rapl", (attempt, e)
-            assert e["rays_per_joule"] == pytest.approx(strict_load(out)["rays"]["total"] / 20e-6)
-            break
+            assert e["rays_per_joule"] == pytest.approx(rays / 20e-6)
+            return
         assert "energy_uj" in e["reason"] and e.get("rays_per_joule") is None, (attempt, e)
-        fd = os.open(zone / "energy_uj", os.O_RDONLY | os.O_NONBLOCK)  # frees a feeder left waiting
-        os.close(fd)
-        t.join(5)
-    else:
-        pytest.fail("three runs in a row read the FIFO out of step: no 20 uJ figure to check")
+    pytest.fail("three renders in a row read the FIFO out of step: no 20 uJ figure to check")
