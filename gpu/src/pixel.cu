@@ -112,8 +112,9 @@ bool big_binary_bvh(const GpuScene::Impl& g) {
   return g.bvh_bytes > device_info().l2_bytes;
 }
 
-// The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy).
-PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
+// The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy; `big`:
+// big_binary_bvh).
+PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big) {
   const bool wide = g.bvh.kind == TraversalKind::Wide;
   const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
@@ -128,9 +129,10 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
                                    "and {})", v, kPixelLatencyBlocks, kPixelBigBvhBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }
-  if (big_binary_bvh(g))
-    return {kPixelBigBvhBlocks, fmt::format("auto: the binary BVH's {:.1f} MB exceed the L2 ({} blocks, the path state "
-                                            "parked)", double(g.bvh_bytes) / 1e6, kPixelBigBvhBlocks)};
+  if (big)
+    return {kPixelBigBvhBlocks,
+            fmt::format("auto: the binary BVH's {:.1f} MB exceed the L2: {} blocks", double(g.bvh_bytes) / 1e6,
+                        kPixelBigBvhBlocks)};
   if (g.bvh_tris >= kPixelLatencyBoundTris)
     return {latency, fmt::format("auto: {} triangles >= {} (latency bound: more warps{})", g.bvh_tris,
                                  kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
@@ -139,11 +141,12 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g) {
 }  // namespace
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
-  PixelOccupancy o = pixel_blocks(g);
+  const bool big = big_binary_bvh(g);  // reads the device's L2 size: once
+  PixelOccupancy o = pixel_blocks(g, big);
   const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
   const std::string v = env ? env : "auto";
-  if (v == "auto") o.parked = leaves || (o.min_blocks == kPixelBigBvhBlocks && big_binary_bvh(g));
+  if (v == "auto") o.parked = leaves || (o.min_blocks == kPixelBigBvhBlocks && big);
   else if (v == "0" || v == "1") o.parked = v == "1";
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
   if (o.parked && !parked_compiled(int(g.bvh.kind), o.min_blocks)) o.parked = false;
@@ -151,7 +154,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
   if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
     o.min_blocks = kLeavesParkedBlocks;
     o.why = fmt::format("auto: the leaves layout, its path state parked: {} blocks", kLeavesParkedBlocks);
-  } else if (o.parked && o.why.find("parked") == std::string::npos) {
+  } else if (o.parked) {
     o.why += "; path state parked in shared memory";
   }
   return o;
