@@ -203,6 +203,34 @@ PB_HD float slab_max(float a, float b) {
 #endif
 }
 
+// A box's entry max(x, y, z, 0) and exit min(x, y, z) from its three slabs' near and far
+// distances. On Hopper, its three-input integer max and min (DPX: VIMNMX3, one instruction
+// each) on the floats' bits: 2 instructions where the float chains take 5 (measured on an
+// H100: the mesh megakernels 3.8-5.1 % faster, films unchanged; docs/notes/gpu-log.md,
+// 2026-11-27). Signed integers order non-negative floats as floats do (+inf included) and
+// put every negative one below them, so: the entry is exact (.relu clamps at +0's bits; a
+// -0 comes out +0, equal in every compare); the exit is exact when all three are > -0, and
+// negative (though perhaps not the least of them) otherwise, a miss either way since the
+// entry is >= 0. The one difference: an exit of -0 (its bits are the least integer) beside
+// a negative one gives -0, so a box the ray left behind it may be entered where its entry
+// is 0. Every box the float chain enters is entered; an extra one holds only what the ray
+// passed before t = 0, which the triangle test's t > t_min rejects: every hit is the float
+// chain's. PB_NO_SLAB_DPX builds the float chains on the device too.
+PB_HD float slab_entry(float x, float y, float z) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900 && !defined(PB_NO_SLAB_DPX)
+  return __int_as_float(__vimax3_s32_relu(__float_as_int(x), __float_as_int(y), __float_as_int(z)));
+#else
+  return slab_max(slab_max(x, y), slab_max(z, 0.0f));
+#endif
+}
+PB_HD float slab_exit(float x, float y, float z) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900 && !defined(PB_NO_SLAB_DPX)
+  return __int_as_float(__vimin3_s32(__float_as_int(x), __float_as_int(y), __float_as_int(z)));
+#else
+  return slab_min(slab_min(x, y), z);
+#endif
+}
+
 // The slab test of one box [x0, x1] x [y0, y1] x [z0, z1]: the ray enters it at tn and
 // leaves at tf (clamped to [0, t], the far end widened: kFarScale); it passes through the
 // box before t if tn <= tf. A binary node's two children and a leaf of the leaves layout (leaf_list.h).
@@ -211,9 +239,8 @@ PB_HD void slab_interval(float x0, float x1, float y0, float y1, float z0, float
   const float tx0 = fmadd(x0, r.inv.x, r.oi.x), tx1 = fmadd(x1, r.inv.x, r.oi.x);
   const float ty0 = fmadd(y0, r.inv.y, r.oi.y), ty1 = fmadd(y1, r.inv.y, r.oi.y);
   const float tz0 = fmadd(z0, r.inv.z, r.oi.z), tz1 = fmadd(z1, r.inv.z, r.oi.z);
-  tn = slab_max(slab_max(slab_min(tx0, tx1), slab_min(ty0, ty1)), slab_max(slab_min(tz0, tz1), 0.0f));
-  tf = slab_min(slab_min(slab_max(tx0, tx1), slab_max(ty0, ty1)), slab_max(tz0, tz1)) * kFarScale;
-  tf = slab_min(tf, t);
+  tn = slab_entry(slab_min(tx0, tx1), slab_min(ty0, ty1), slab_min(tz0, tz1));
+  tf = slab_min(slab_exit(slab_max(tx0, tx1), slab_max(ty0, ty1), slab_max(tz0, tz1)) * kFarScale, t);
 }
 
 }  // namespace detail

@@ -229,8 +229,8 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
           const float tx1 = detail::fmadd(detail::byte_as_float(qf[0], j), a[0], b[0]);
           const float ty1 = detail::fmadd(detail::byte_as_float(qf[1], j), a[1], b[1]);
           const float tz1 = detail::fmadd(detail::byte_as_float(qf[2], j), a[2], b[2]);
-          const float tn = detail::slab_max(detail::slab_max(tx0, ty0), detail::slab_max(tz0, 0.0f));
-          const float tf = detail::slab_min(detail::slab_min(detail::slab_min(tx1, ty1), tz1) * kFarScale, t);
+          const float tn = detail::slab_entry(tx0, ty0, tz0);
+          const float tf = detail::slab_min(detail::slab_exit(tx1, ty1, tz1) * kFarScale, t);
           if (meta != 0 && tn <= tf) {
             const uint32_t slot = 4u * half + j;
             const bool inner = (imask >> slot) & 1u;
