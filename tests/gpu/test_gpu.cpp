@@ -15,6 +15,7 @@
 #include "pathbench/common/errors.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/gpu/render.h"
+#include "require_gpu.h"
 #include "pathbench/run/run.h"
 #include "film_agreement.h"
 #include "traversal_check.h"
@@ -26,12 +27,6 @@
 namespace pb::gpu {
 using namespace pb::bvh;  // the BVH library (bvh/) the tracer under test uses
 namespace {
-
-#define PB_REQUIRE_GPU()                                        \
-  do {                                                          \
-    std::string why;                                            \
-    if (!device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
-  } while (0)
 
 RenderSettings small_settings(Strategy strategy, uint32_t size = 64, uint32_t spp = 32) {
   RenderSettings s;

@@ -13,18 +13,13 @@
 #include "pathbench/bvh/host_tracer.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/gpu/render.h"
+#include "require_gpu.h"
 
 namespace pb::gpu {
 using namespace pb::bvh;  // the BVH library (bvh/) the tracer under test uses
 namespace {
 
 const std::string kRoot = std::string(PATHBENCH_SOURCE_DIR) + "/";
-
-#define PB_REQUIRE_GPU()                                             \
-  do {                                                               \
-    std::string why;                                                 \
-    if (!device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
-  } while (0)
 
 Scene quiet_load(const std::string& path) {
   testing::internal::CaptureStderr();

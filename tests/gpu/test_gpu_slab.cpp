@@ -17,16 +17,11 @@
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/gpu/render.h"
+#include "require_gpu.h"
 
 namespace pb::gpu {
 using namespace pb::bvh;  // the BVH library (bvh/) the tracer under test uses
 namespace {
-
-#define PB_REQUIRE_GPU()                                             \
-  do {                                                               \
-    std::string why;                                                 \
-    if (!device_available(&why)) GTEST_SKIP() << "no GPU: " << why; \
-  } while (0)
 
 // Origins inside the scene's box with one coordinate moved onto its lower plane, or to 0, in
 // turn (or none), each sending a ray along the 26 axis, face-diagonal and diagonal directions.
