@@ -1,9 +1,10 @@
-// The slab test's entry and exit on the device (bvh/hit_tests.h slab_entry / slab_exit: Hopper's
-// three-input integer max / min on the floats' bits) against the host's float chains, where
-// the two may differ: slab distances of -0 (ray origins exactly on a box plane, or at 0) and
-// of huge magnitude (direction components of 0: 1 / d is +-1e30). Ray by ray, closest hits and
-// any-hits, on every layout whose node test uses them, the device answers as the host: the
-// same triangle at the same t, bit for bit (label gpu; SKIPPED without a device).
+// The slab test's entry, exit and far end on the device (bvh/hit_tests.h slab_entry, slab_exit,
+// slab_far: Hopper's three-input integer max / min and add-min on the floats' bits) against the
+// host's forms, where the two may differ: slab distances of -0 (ray origins exactly on a box
+// plane, or at 0) and of huge magnitude (direction components of 0: 1 / d is +-1e30). Ray by
+// ray, closest hits and any-hits, on every layout whose node test uses them, the device
+// answers as the host: the same triangle at the same t, bit for bit (label gpu; SKIPPED
+// without a device). (The far end's bounds on the host: test_slab.cpp.)
 // (Random rays and rays at edges: test_gpu.cpp, GpuTraversal.DeviceMatchesHostAndEmbree.)
 #include <gtest/gtest.h>
 

@@ -6,6 +6,7 @@
 // the bit helpers of child and leaf masks. Host+device code: the GPU kernels and the
 // host-side tests run the same functions.
 #include <cstdint>
+#include <cstring>
 
 #include "pathbench/common/hd.h"
 #include "pathbench/common/math.h"
@@ -176,9 +177,6 @@ PB_HD SlabRay make_slab_ray(const Vec3f& o, const Vec3f& d) {
   const Vec3f inv = {safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z)};
   return {inv, {-(o.x * inv.x), -(o.y * inv.y), -(o.z * inv.z)}};
 }
-// Slab distances carry a few roundings: widen the far end (Ize 2013, 1 + 2 gamma(3));
-// the builders also pad every box by a few ulps of the scene's scale.
-constexpr float kFarScale = 1.0000004f;
 
 // The slab test's min and max: one FMNMX each on the device, where pmin / pmax (a < b ?
 // a : b) compile to a compare and a select, two instructions (16 more a binary node: a
@@ -211,11 +209,11 @@ PB_HD float slab_max(float a, float b) {
 // put every negative one below them, so: the entry is exact (.relu clamps at +0's bits; a
 // -0 comes out +0, equal in every compare); the exit is exact when all three are > -0, and
 // negative (though perhaps not the least of them) otherwise, a miss either way since the
-// entry is >= 0. The one difference: an exit of -0 (its bits are the least integer) beside
-// a negative one gives -0, so a box the ray left behind it may be entered where its entry
-// is 0. Every box the float chain enters is entered; an extra one holds only what the ray
-// passed before t = 0, which the triangle test's t > t_min rejects: every hit is the float
-// chain's. PB_NO_SLAB_DPX builds the float chains on the device too.
+// entry is >= 0. An exit of -0 (its bits are the least integer) beside a negative one gives
+// -0 where the float chain gives the negative one; slab_far (below) makes both a miss. The
+// one box the two may still decide apart is one the ray leaves at t = 0 exactly (an exit of
+// -0 beside +0, which the host's ternary min may give as +0): it holds no hit t > 0, which
+// the triangle test requires. PB_NO_SLAB_DPX builds the float chains on the device too.
 PB_HD float slab_entry(float x, float y, float z) {
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900 && !defined(PB_NO_SLAB_DPX)
   return __int_as_float(__vimax3_s32_relu(__float_as_int(x), __float_as_int(y), __float_as_int(z)));
@@ -231,8 +229,39 @@ PB_HD float slab_exit(float x, float y, float z) {
 #endif
 }
 
+// Slab distances carry a few roundings: the far end is widened (Ize 2013: by 1 + 2 gamma(3),
+// that is 6u of it, u = 2^-24) and clamped to t, the best distance so far. Widened here by
+// kFarUlps units in the last place on the floats' bits: an ulp is at least u of a float, so
+// 6 of them are at least the product exit * (1 + 6u) rounded, which is what it was (3 to 6
+// ulps): every box entered before is entered. The builders also pad every box by a few ulps
+// of the scene's scale. On Hopper min(bits(exit) + 6, bits(t)) is one DPX instruction
+// (VIADDMNMX) where the product and the clamp took two (docs/notes/gpu-log.md, 2026-11-27).
+// t > 0, so its bits order as the float does. A non-negative exit stays so (bits at most
+// 0x7F800000 + 6 where the exit is +inf, above t's as a NaN's are, so t is taken). A
+// negative one, -0 included, stays negative (its bits are a negative integer and 6 more
+// still is), so tf < 0 <= tn: a miss, as the float chain's negative exit is, and so is
+// DPX's exit of -0 (slab_exit).
+constexpr int32_t kFarUlps = 6;
+PB_HD float slab_far(float exit, float t) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900 && !defined(PB_NO_SLAB_DPX)
+  return __int_as_float(__viaddmin_s32(__float_as_int(exit), kFarUlps, __float_as_int(t)));
+#elif defined(__CUDA_ARCH__)
+  const int e = int(unsigned(__float_as_int(exit)) + unsigned(kFarUlps)), b = __float_as_int(t);
+  return __int_as_float(e < b ? e : b);
+#else
+  int32_t e, b;
+  std::memcpy(&e, &exit, sizeof e);
+  std::memcpy(&b, &t, sizeof b);
+  e = int32_t(uint32_t(e) + uint32_t(kFarUlps));  // no signed overflow (modular from C++20)
+  const int32_t m = e < b ? e : b;
+  float f;
+  std::memcpy(&f, &m, sizeof f);
+  return f;
+#endif
+}
+
 // The slab test of one box [x0, x1] x [y0, y1] x [z0, z1]: the ray enters it at tn and
-// leaves at tf (clamped to [0, t], the far end widened: kFarScale); it passes through the
+// leaves at tf (clamped to [0, t], the far end widened: slab_far); it passes through the
 // box before t if tn <= tf. A binary node's two children and a leaf of the leaves layout (leaf_list.h).
 PB_HD void slab_interval(float x0, float x1, float y0, float y1, float z0, float z1, const SlabRay& r, float t,
                          float& tn, float& tf) {
@@ -240,7 +269,7 @@ PB_HD void slab_interval(float x0, float x1, float y0, float y1, float z0, float
   const float ty0 = fmadd(y0, r.inv.y, r.oi.y), ty1 = fmadd(y1, r.inv.y, r.oi.y);
   const float tz0 = fmadd(z0, r.inv.z, r.oi.z), tz1 = fmadd(z1, r.inv.z, r.oi.z);
   tn = slab_entry(slab_min(tx0, tx1), slab_min(ty0, ty1), slab_min(tz0, tz1));
-  tf = slab_min(slab_exit(slab_max(tx0, tx1), slab_max(ty0, ty1), slab_max(tz0, tz1)) * kFarScale, t);
+  tf = slab_far(slab_exit(slab_max(tx0, tx1), slab_max(ty0, ty1), slab_max(tz0, tz1)), t);
 }
 
 }  // namespace detail

@@ -174,7 +174,6 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
                              TraversalStats* stats = nullptr) {
   const WatertightRay wr = make_watertight_ray(o, d);
   const auto [inv, oi] = detail::make_slab_ray(o, d);
-  using detail::kFarScale;
   // Octant of the direction, inverted: child slots are numbered by the corner of the
   // node they lie toward (bit set = + side), so slot s ^ oct_inv == 7 is entered first.
   const uint32_t oct = (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
@@ -230,7 +229,7 @@ PB_HD uint32_t traverse_wide(const WideBvhView& bvh, const Vec3f& o, const Vec3f
           const float ty1 = detail::fmadd(detail::byte_as_float(qf[1], j), a[1], b[1]);
           const float tz1 = detail::fmadd(detail::byte_as_float(qf[2], j), a[2], b[2]);
           const float tn = detail::slab_entry(tx0, ty0, tz0);
-          const float tf = detail::slab_min(detail::slab_exit(tx1, ty1, tz1) * kFarScale, t);
+          const float tf = detail::slab_far(detail::slab_exit(tx1, ty1, tz1), t);
           if (meta != 0 && tn <= tf) {
             const uint32_t slot = 4u * half + j;
             const bool inner = (imask >> slot) & 1u;
