@@ -105,11 +105,12 @@ constexpr bool parked_compiled(int kind, int blocks) {
 static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kPixelLatencyBlocks == 8 && kPixelBigBvhBlocks == 6,
               "the counts compiled: 3, 5 and 8, and 6 for the binary BVH");
 
-// The scene's BVH exceeds the device's L2 (the binary layout's nodes and triangles): auto
-// runs its megakernel at kPixelBigBvhBlocks with the path state parked (strategies.cuh).
-bool big_binary_bvh(const GpuScene::Impl& g) {
+// The scene's BVH exceeds the device's L2 of l2_bytes (the binary layout's nodes and
+// triangles): auto runs its megakernel at kPixelBigBvhBlocks with the path state parked
+// (strategies.cuh).
+bool big_binary_bvh(const GpuScene::Impl& g, uint64_t l2_bytes) {
   if (g.bvh.kind != TraversalKind::Binary || g.bvh.binary.exact_ties) return false;
-  return g.bvh_bytes > device_info().l2_bytes;
+  return g.bvh_bytes > l2_bytes;
 }
 
 // The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy; `big`:
@@ -140,8 +141,8 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big) {
 }
 }  // namespace
 
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g) {
-  const bool big = big_binary_bvh(g);  // reads the device's L2 size: once
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes) {
+  const bool big = big_binary_bvh(g, l2_bytes);
   PixelOccupancy o = pixel_blocks(g, big);
   const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");

@@ -85,7 +85,8 @@ constexpr int kWideLatencyBlocks = 5;
 // blocks 10.645 ms, at 4 10.749, at 5 10.454; parked at 3 (64 registers: 4 blocks run)
 // 10.245, parked at 5 (48 registers, 100 / 84 bytes spilled) 10.131.
 constexpr int kLeavesParkedBlocks = 5;
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g);
+// l2_bytes: the device's L2 (RenderSetup's DeviceInfo, the cache's copy where one is kept).
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from
 // a counter (work_chunks.cuh): more where traversals diverge (from kPixelLatencyBoundTris
