@@ -66,7 +66,7 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
   const uint32_t lane = threadIdx.x & 31;
   uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0;
   // Every chunk of 32 samples from the counter (work_chunks.cuh).
-  for_each_chunk<unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, [&](unsigned long long k) {
+  auto chunk = [&](unsigned long long k) {
     const uint64_t g = k * 32 + lane;
     const bool valid = g < total;
     const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / c.spp) : kNoPixel;
@@ -83,7 +83,11 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
       ++n_paths;
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &ctr->stats.discarded);
-  });
+  };
+  // Parked: the chunk loop's state in shared memory too (for_each_chunk_parked), not in four
+  // registers live through every traversal.
+  if constexpr (kParked) for_each_chunk_parked<8, unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
+  else for_each_chunk<unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
   block_stats_add(&ctr->stats, n_bounce, n_shadow, n_paths);
 }
 
