@@ -39,15 +39,13 @@ __device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* co
   }
 }
 
-// The wavefront's split: every full round of the grid stride static but the last
-// `counter_rounds`; those and the partial round from the counter. No more chunks than
-// warps: all static (no warp takes two, so there is nothing to balance).
 // for_each_chunk with its state between chunks (the chunk and the claim in flight) in the
 // block's shared memory, one slot a warp, instead of in registers that stay live through
 // body(k): the parked pixel megakernel's (pixel.cu), whose traversals run at the register
 // cap (H100, interleaved, same films: ico:8 0.995, paper-cornell 0.996, large-mesh 0.994;
-// docs/notes/gpu-log.md, 2026-11-27). kWarps: the block's warps. The __syncwarp calls order
-// the leader's write of the next chunk after every lane's read of the last one.
+// docs/notes/gpu-log.md, 2026-11-27). kWarps: the block's warps (blocks of 32 kWarps
+// threads). The __syncwarp calls order the leader's write of the next chunk after every
+// lane's read of the last one.
 template <int kWarps, class Index, class Body>
 __device__ __forceinline__ void for_each_chunk_parked(Index end, Index fixed, Index* counter, Body&& body) {
   __shared__ Index next[kWarps];
@@ -67,6 +65,9 @@ __device__ __forceinline__ void for_each_chunk_parked(Index end, Index fixed, In
   }
 }
 
+// The wavefront's split: every full round of the grid stride static but the last
+// `counter_rounds`; those and the partial round from the counter. No more chunks than
+// warps: all static (no warp takes two, so there is nothing to balance).
 __device__ __forceinline__ uint32_t static_chunks(uint32_t end, uint32_t counter_rounds) {
   const uint32_t warps = grid_threads() >> 5, rounds = end / warps;
   if (end <= warps) return end + warps;  // for_each_chunk: no claims
