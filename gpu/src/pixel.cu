@@ -59,8 +59,12 @@ template <class T> struct ParkedPath {
 };
 static_assert(sizeof(ParkedPath<float>) == 100, "25 words: an odd stride in words");
 
+// The most threads a block of k_pixel has (its launch bounds; the launcher picks 64 to 256):
+// the parked state's shared arrays are sized for it.
+constexpr int kPixelMaxBlock = 256;
+
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks, bool kParked = false>
-__global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint64_t total,
+__global__ void __launch_bounds__(kPixelMaxBlock, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint64_t total,
                                                FilmDev film, PixelCounters* ctr) {
   kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
@@ -73,7 +77,7 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
       if constexpr (kParked) {
-        __shared__ ParkedPath<T> parked[256];
+        __shared__ ParkedPath<T> parked[kPixelMaxBlock];
         ParkedPath<T>& p = parked[threadIdx.x];
         L = trace_path_bvh_in<Kinds, T, kWatertight, kKind>(s, bvh, c, pixel, c.first_sample + uint32_t(g % c.spp),
                                                             n_bounce, n_shadow, p.st, p.q);
@@ -86,7 +90,7 @@ __global__ void __launch_bounds__(256, kMinBlocks) k_pixel(SceneView s, BvhView 
   };
   // Parked: the chunk loop's state in shared memory too (for_each_chunk_parked), not in four
   // registers live through every traversal.
-  if constexpr (kParked) for_each_chunk_parked<8, unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
+  if constexpr (kParked) for_each_chunk_parked<kPixelMaxBlock / 32, unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
   else for_each_chunk<unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
   block_stats_add(&ctr->stats, n_bounce, n_shadow, n_paths);
 }

@@ -43,8 +43,8 @@ __device__ __forceinline__ void for_each_chunk(Index end, Index fixed, Index* co
 // block's shared memory, one slot a warp, instead of in registers that stay live through
 // body(k): the parked pixel megakernel's (pixel.cu), whose traversals run at the register
 // cap (H100, interleaved, same films: ico:8 0.995, paper-cornell 0.996, large-mesh 0.994;
-// docs/notes/gpu-log.md, 2026-11-27). kWarps: the block's warps (blocks of 32 kWarps
-// threads). The __syncwarp calls order the leader's write of the next chunk after every
+// docs/notes/gpu-log.md, 2026-11-27). kWarps: the most warps a block has (its
+// slots). The __syncwarp calls order the leader's write of the next chunk after every
 // lane's read of the last one.
 template <int kWarps, class Index, class Body>
 __device__ __forceinline__ void for_each_chunk_parked(Index end, Index fixed, Index* counter, Body&& body) {

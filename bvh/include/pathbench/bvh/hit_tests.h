@@ -245,9 +245,6 @@ constexpr int32_t kFarUlps = 6;
 PB_HD float slab_far(float exit, float t) {
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900 && !defined(PB_NO_SLAB_DPX)
   return __int_as_float(__viaddmin_s32(__float_as_int(exit), kFarUlps, __float_as_int(t)));
-#elif defined(__CUDA_ARCH__)
-  const int e = int(unsigned(__float_as_int(exit)) + unsigned(kFarUlps)), b = __float_as_int(t);
-  return __int_as_float(e < b ? e : b);
 #else
   int32_t e, b;
   std::memcpy(&e, &exit, sizeof e);
