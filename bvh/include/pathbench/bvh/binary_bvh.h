@@ -59,7 +59,16 @@ PB_HD void load_node(const BvhNode* nodes, uint32_t i, float (&x)[4], float (&y)
 // leaf(first, count) tests a leaf's items and returns true to end the walk (an any-hit
 // query's hit); then walk_binary returns true. Shared by the flat traversal below and
 // both levels of the two-level one (two_level_bvh.h).
-template <class Leaf>
+// kFarFirst: where the ray enters both children, the farther first (ties: the second). The
+// flat traversal's any-hit (shadow) walks take it: the same answers through other nodes, and
+// fewer nodes' time on the GPU. Interleaved against nearer first on an H100, 256x256x800 nee
+// (results/nvidia-h100-80gb-hbm3/archive/shadow-order-82da7ca, call3; same films): pixel
+// megakernel large-mesh 0.873, bunny-armadillo 0.967, glass-dragon 0.983, paper-cornell-ico:8
+// 0.969, ico:5 0.992, cornell-materials 0.992; ico:8 wavefront 0.968, paper-queue 0.937; only
+// a tiny mesh lost (ico:1, 94 triangles: 1.007). A host count of warp steps (max over a warp's
+// lanes) had favoured nearer first on the icospheres (1.04-1.05x): it misses what the GPU
+// gains, perhaps the shared nodes of a pixel's shadow rays walked toward one light.
+template <bool kFarFirst = false, class Leaf>
 PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, const float& t, Leaf&& leaf,
                        TraversalStats* stats) {
   const SlabRay sr = make_slab_ray(o, d);
@@ -77,7 +86,7 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
         slab_interval(x[2 * c], x[2 * c + 1], y[2 * c], y[2 * c + 1], z[2 * c], z[2 * c + 1], sr, t, tn[c], tf[c]);
       const bool h0 = tn[0] <= tf[0], h1 = tn[1] <= tf[1];
       if (h0 && h1) {
-        const bool swap = tn[1] < tn[0];
+        const bool swap = (tn[1] < tn[0]) != kFarFirst;
         ref = swap ? child[1] : child[0];
         stack[sp++] = swap ? child[0] : child[1];
       } else if (h0 || h1) {
@@ -112,7 +121,7 @@ PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d
   const WatertightRay wr = make_watertight_ray(o, d);
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
-  const bool stopped = detail::walk_binary(
+  const bool stopped = detail::walk_binary<kAnyHit>(
       bvh.nodes, o, d, t,
       [&](uint32_t first, uint32_t count) {
         return detail::test_leaf_triangles<kAnyHit, kWatertight>(bvh.tris, first, count, wr, o, d, t_max, exact, t,
