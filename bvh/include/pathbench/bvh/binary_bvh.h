@@ -65,9 +65,9 @@ PB_HD void load_node(const BvhNode* nodes, uint32_t i, float (&x)[4], float (&y)
 // (results/nvidia-h100-80gb-hbm3/archive/shadow-order-82da7ca, call3; same films): pixel
 // megakernel large-mesh 0.873, bunny-armadillo 0.967, glass-dragon 0.983, paper-cornell-ico:8
 // 0.969, ico:5 0.992, cornell-materials 0.992; ico:8 wavefront 0.968, paper-queue 0.937; only
-// a tiny mesh lost (ico:1, 94 triangles: 1.007). A host count of warp steps (max over a warp's
-// lanes) had favoured nearer first on the icospheres (1.04-1.05x): it misses what the GPU
-// gains, perhaps the shared nodes of a pixel's shadow rays walked toward one light.
+// a tiny mesh lost (ico:1, 94 triangles: 1.007). A host model of this loop on SIMT lanes agrees
+// on every scene: per leaf visit a warp pays the most nodes any lane walked to it plus the most
+// triangles any lane tests there (that folder's host-model-while-while.txt).
 template <bool kFarFirst = false, class Leaf>
 PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, const float& t, Leaf&& leaf,
                        TraversalStats* stats) {
