@@ -38,8 +38,7 @@ print("\t".join([sys.argv[2], sys.argv[3], sys.argv[4], f"{r['device_seconds'] *
                  str(occ.get("min_blocks_per_sm", "")), str(occ.get("parked_path_state", "")),
                  "{layout} {nodes} nodes {triangle_refs} refs depth {depth} SAH {sah_cost:.2f} {build_seconds:.2f} s".format(
                      **{"layout": "?", "nodes": 0, "triangle_refs": 0, "depth": 0, "sah_cost": 0.0, "build_seconds": 0.0,
-                        **r.get("bvh", {})})
-                 + " shadows {order}".format(**{"order": "-", **r.get("bvh", {}).get("shadow_order", {})})]))
+                        **r.get("bvh", {})})]))
 PY
     done < "$variants"
   done
