@@ -9,11 +9,16 @@
 # ab.txt (the comparison) and ab.tsv (every render). Needs .gpu-deps (../shared/gpu-host/README.md);
 # the suite's meshes from .wt-carry/suite-data (scripts/pack-suite-data.sh) where present.
 set -uo pipefail
-out=${1:?usage: scripts/device/gpu_trees_ab.sh OUT_DIR VARIANTS CASES NAME[:PATCH] ...}
-variants=$(realpath "${2:?usage: scripts/device/gpu_trees_ab.sh OUT_DIR VARIANTS CASES NAME[:PATCH] ...}")
-cases=$(realpath "${3:?usage: scripts/device/gpu_trees_ab.sh OUT_DIR VARIANTS CASES NAME[:PATCH] ...}")
+usage="usage: scripts/device/gpu_trees_ab.sh OUT_DIR VARIANTS CASES NAME[:PATCH] ..."
+out=${1:?$usage}; variants=${2:?$usage}; cases=${3:?$usage}
 shift 3
 [ $# -gt 0 ] || { echo "gpu_trees_ab.sh: no tree named" >&2; exit 2; }
+inputs=("$variants" "$cases")
+for t in "$@"; do [ "${t#*:}" != "$t" ] && inputs+=("${t#*:}"); done
+for f in "${inputs[@]}"; do
+  if [ ! -f "$f" ] || [ ! -r "$f" ]; then echo "gpu_trees_ab.sh: $f: not a readable file" >&2; exit 2; fi
+done  # before anything is built
+variants=$(realpath "$variants"); cases=$(realpath "$cases")
 mkdir -p "$out" && out=$(realpath "$out")
 cd "$(dirname "${BASH_SOURCE[0]}")/../.." || exit 1
 # shellcheck disable=SC1091  # made on the development host (../shared/gpu-host/README.md)
