@@ -1,6 +1,6 @@
 // The binary BVH's any-hit (shadow) walks take the farther child first (binary_bvh.h,
-// walk_binary's kFarFirst): the same answers as the closest-hit walk's, segment by segment,
-// through other nodes than the nearer-first walk's. Plain C++ (label unit); the device runs
+// traverse's kFarFirst): the same answers as the closest-hit walk's, segment by segment,
+// through other nodes than the nearer-first walk's. (The two-level BVH's: test_two_level.cpp.) Plain C++ (label unit); the device runs
 // the same function (GpuSlab and GpuTraversal check its any-hits against the host's).
 #include <gtest/gtest.h>
 
@@ -31,18 +31,10 @@ TEST(AnyHitOrder, FarFirstAnswersAsTheClosestHitThroughOtherNodes) {
       const bool hit = traverse<true>(v, from, d, 1.0f, t_any, &any) != kNoHit;
       blocked += hit;
       differ += hit != (traverse<false>(v, from, d, 1.0f, t_closest) != kNoHit);
-      // The nearer-first walk of the same query: its nodes, leaves tested until one is hit.
-      const WatertightRay wr = make_watertight_ray(from, d);
-      float t = 1.0f;
-      uint32_t prim = kNoHit, slot = 0;
+      // The nearer-first walk of the same query (traverse's kFarFirst = false).
+      float t_near = 0;
       TraversalStats near;
-      detail::walk_binary<false>(
-          v.nodes, from, d, t,
-          [&](uint32_t first, uint32_t count) {
-            return detail::test_leaf_triangles<true, true>(v.tris, first, count, wr, from, d, 1.0f, false, t, prim,
-                                                           slot, &near);
-          },
-          &near);
+      const uint32_t prim = traverse<true, true, -1, false>(v, from, d, 1.0f, t_near, &near);
       differ += hit != (prim != kNoHit);
       other_nodes += near.nodes != any.nodes;
     }

@@ -114,14 +114,16 @@ PB_HD bool walk_binary(const BvhNode* nodes, const Vec3f& o, const Vec3f& d, con
 // the hot kernels are compiled for one or the other, since a run-time flag keeps the tie
 // compare's registers live in every kernel (ptxas, sm_90, k_pixel: 48 -> 60 bytes of
 // spill stores, 64 -> 84 of loads) and cost flat scenes ~2 % (docs/notes/gpu-log.md).
-template <bool kAnyHit, bool kWatertight = true, int kExact = -1>
+// kFarFirst: walk_binary's child order; any-hit walks take the farther child first (the
+// renderers' order; tests pass false to compare with the nearer-first walk).
+template <bool kAnyHit, bool kWatertight = true, int kExact = -1, bool kFarFirst = kAnyHit>
 PB_HD uint32_t traverse(const BinaryBvhView& bvh, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                         TraversalStats* stats = nullptr) {
   const bool exact = kExact < 0 ? bvh.exact_ties != 0 : kExact == 1;
   const WatertightRay wr = make_watertight_ray(o, d);
   uint32_t hit = kNoHit, hit_slot = 0;
   float t = t_max;
-  const bool stopped = detail::walk_binary<kAnyHit>(
+  const bool stopped = detail::walk_binary<kFarFirst>(
       bvh.nodes, o, d, t,
       [&](uint32_t first, uint32_t count) {
         return detail::test_leaf_triangles<kAnyHit, kWatertight>(bvh.tris, first, count, wr, o, d, t_max, exact, t,

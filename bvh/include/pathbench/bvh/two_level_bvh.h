@@ -63,7 +63,7 @@ PB_HD void load_flat_triangle(const TwoLevelView& v, uint32_t tri, Vec3f& a, Vec
 
 }  // namespace detail
 
-// As traverse() in bvh.h (same arguments, same answer on the flat scene's triangles).
+// As traverse() in binary_bvh.h (same arguments, same answer on the flat scene's triangles).
 template <bool kAnyHit, bool kWatertight = true>
 PB_HD uint32_t traverse_two_level(const TwoLevelView& v, const Vec3f& o, const Vec3f& d, float t_max, float& t_hit,
                                   TraversalStats* stats = nullptr) {
