@@ -194,8 +194,10 @@ def main():
     ctx = contexts[0]
     out_dir = a.out_dir or os.path.join("results", ctx.get("machine", "unknown-machine"))
     os.makedirs(out_dir, exist_ok=True)
-    machines = sorted({c.get("cpu_model", "?") + (f" + {c['gpu_name']}" if "gpu_name" in c else "") for c in contexts})
-    title = f"{'; '.join(machines)} (git {ctx.get('git_revision', '?')})"
+    # Each file's machine with its own commit: the files may come from different commits.
+    machines = sorted({c.get("cpu_model", "?") + (f" + {c['gpu_name']}" if "gpu_name" in c else "") +
+                       f" (git {(str(c.get('git_revision') or '?').split() or ['?'])[0]})" for c in contexts})
+    title = "\n".join(machines)
     plot_rays_vs_triangles(renders, raycasts, os.path.join(out_dir, "scaling-rays-vs-triangles.png"), title)
     plot_time_sweep(renders, os.path.join(out_dir, "scaling-time-vs-spp.png"),
                     f"{title}\nrender time vs spp (paper-cornell 128x128, nee)", lambda r: r["spp"],
