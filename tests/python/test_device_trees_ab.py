@@ -1,6 +1,7 @@
 """scripts/device/gpu_trees_ab.sh refuses what it cannot read before it copies or builds
 anything: a missing variants, cases or patch file, or no tree at all, is one line on stderr
-and exit 2, and the output folder is not made. (Its builds and runs need the GPU host.)"""
+and exit 2, and the output folder is not made. gpu_bench_scaling.sh refuses a part NAME that is not
+a plain file name, before it makes anything. (Their builds and runs need the GPU host.)"""
 import subprocess
 from pathlib import Path
 
@@ -25,4 +26,17 @@ def test_refuses_unreadable_inputs_before_building(tmp_path):
         assert r.returncode == 2, (args, r.stdout, r.stderr)
         assert named in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
         assert r.stdout == ""
+        assert not (tmp_path / "out").exists()
+
+
+SCALING = ROOT / "scripts" / "device" / "gpu_bench_scaling.sh"
+
+
+def test_bench_scaling_refuses_a_name_it_would_write_as_a_path(tmp_path):
+    # NAME becomes part of file names under OUT_DIR: a slash or a space could write elsewhere.
+    for name in ["../x", "a b", "x/y", ""]:
+        r = subprocess.run(["bash", str(SCALING), str(tmp_path / "out"), name, "gpu/pixel/"], capture_output=True,
+                           text=True, timeout=60)
+        assert r.returncode != 0, (name, r.stdout, r.stderr)
+        assert len(r.stderr.strip().splitlines()) == 1, r.stderr
         assert not (tmp_path / "out").exists()
