@@ -10,18 +10,26 @@ The parts must come from the same source commit, machine and GPU, and no benchma
 two parts. The merged file keeps the first part's context, its benchmarks in the parts' order,
 the union of the parts' film hashes with film_hash recomputed over them as pathbench-bench
 computes it (bench/bench_context.cpp), and a "merged_from" list with each part's date and load.
-Bad input (unreadable or not a benchmark JSON, parts that do not match) exits 2 with one line
-on stderr and writes nothing.
+Bad input (not a regular file, over 64 MiB, not a benchmark JSON, parts that do not match) exits
+2 with one line on stderr and writes nothing; the output goes into place whole or not at all
+(a temporary file of its own beside it, renamed), so two merges into one path never mix.
 """
 import json
 import os
 import sys
+
+from atomic_file import write_text_atomically
+from history.fields import RecordError, read_bytes  # the history importer's reader: regular files, a size limit
+
+MAX_PART_BYTES = 64 << 20  # benchmark JSON's limit (docs/reference.md)
 
 # Context fields that must agree: the parts describe one build on one machine.
 SAME = ("git_revision", "machine_id", "gpu_name", "gpu_driver", "pathbench_preset", "build_type")
 
 
 def fnv1a64(text):
+    """Standard FNV-1a 64, as bench/bench_context.cpp hashes the films. (Not tools/machine.py's
+    fnv1a64_hex, whose offset basis differs: machine ids are another hash.)"""
     h = 0xCBF29CE484222325
     for byte in text.encode():
         h = ((h ^ byte) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
@@ -30,10 +38,11 @@ def fnv1a64(text):
 
 def load(path):
     try:
-        with open(path, encoding="utf-8") as f:
-            doc = json.load(f)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        doc = json.loads(read_bytes(path, MAX_PART_BYTES).decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as e:
         raise ValueError(f"{path}: {e}") from None
+    except RecordError as e:  # not a regular file, too large, unreadable
+        raise ValueError(str(e)) from None
     if not isinstance(doc, dict) or not isinstance(doc.get("context"), dict) or \
             not isinstance(doc.get("benchmarks"), list):
         raise ValueError(f"{path}: not a Google Benchmark JSON (no context object and benchmarks list)")
@@ -87,14 +96,11 @@ def main(argv=None):
     except ValueError as e:
         print(f"merge_bench_json: {e}", file=sys.stderr)
         return 2
-    tmp = out + ".tmp"
     try:
-        with open(tmp, "w", encoding="utf-8") as f:
-            json.dump(merged, f, indent=2)
-            f.write("\n")
-        os.replace(tmp, out)
+        # As Google Benchmark writes it: NaN allowed, since its counters may hold one.
+        write_text_atomically(out, json.dumps(merged, indent=2) + "\n")
     except OSError as e:
-        print(f"merge_bench_json: {out}: {e}", file=sys.stderr)
+        print(f"merge_bench_json: {out}: {e.strerror or e}", file=sys.stderr)
         return 2
     print(f"{out}: {len(merged['benchmarks'])} benchmarks from {len(parts)} parts")
     return 0

@@ -3,12 +3,11 @@ quartiles), the speed-up over Mitsuba round by round, the Markdown table and the
 from __future__ import annotations
 
 import json
-import os
 import statistics
-import tempfile
 from pathlib import Path
 
 import isa_emulation
+from atomic_file import write_text_atomically
 
 
 def spread(values):
@@ -49,19 +48,7 @@ def add_speedups(res):
 def write_json(path: Path, obj):
     """Strict JSON (no NaN or Infinity: ValueError before anything is written), put in place
     atomically, so a failed run leaves no half-written file."""
-    text = json.dumps(obj, indent=2, allow_nan=False) + "\n"
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # as open() would make it, not mkstemp's 0600
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    write_text_atomically(path, json.dumps(obj, indent=2, allow_nan=False) + "\n")
 
 
 def layout_lines(pb, raw=False):

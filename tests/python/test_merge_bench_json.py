@@ -3,6 +3,7 @@ the benchmarks in the parts' order, the union of their film hashes with film_has
 pathbench-bench computes it, and each part's date and load; parts of different builds or machines,
 a benchmark in two parts, or a file that is not benchmark JSON exit 2 with one line and write nothing."""
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -49,6 +50,17 @@ def test_merges_parts_in_order_with_their_film_hashes(tmp_path):
     assert [p["file"] for p in m["context"]["merged_from"]] == ["a.json", "b.json"]
     assert m["context"]["merged_from"][1]["date"] == "2026-11-28T05:34:09"
     assert m["context"]["date"] == "2026-11-28T05:32:00"  # the first part's context
+    assert not list(tmp_path.glob(".merged.json*"))  # the temporary file renamed, none left
+
+
+def test_keeps_a_nan_counter_as_google_benchmark_writes_it(tmp_path):
+    a = part(tmp_path, "a", ["r/x"], "d1")
+    doc = json.loads(a.read_text())
+    doc["benchmarks"][0]["rays_per_joule"] = float("nan")
+    a.write_text(json.dumps(doc))
+    out = tmp_path / "merged.json"
+    assert run(out, a).returncode == 0
+    assert "NaN" in out.read_text()
 
 
 def test_refuses_parts_that_do_not_belong_together(tmp_path):
@@ -60,14 +72,28 @@ def test_refuses_parts_that_do_not_belong_together(tmp_path):
     not_json.write_text("{ not json")
     no_benchmarks = tmp_path / "f.json"
     no_benchmarks.write_text(json.dumps({"context": {}}))
+    fifo = tmp_path / "g.json"
+    os.mkfifo(fifo)  # would block a reader that opened it
+    huge = tmp_path / "h.json"
+    with open(huge, "wb") as f:
+        f.truncate((64 << 20) + 1)
     for bad, says in [(other_build, "git_revision"), (other_machine, "machine_id"), (twice, "r/x"),
                       (not_json, "e.json"), (no_benchmarks, "not a Google Benchmark JSON"),
-                      (tmp_path / "missing.json", "missing.json")]:
+                      (tmp_path / "missing.json", "missing.json"), (fifo, "not a regular file"),
+                      (Path("/dev/zero"), "not a regular file"), (huge, "larger than 64 MiB")]:
         out = tmp_path / "merged.json"
         r = run(out, a, bad)
         assert r.returncode == 2, (bad, r.stdout, r.stderr)
         assert says in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
-        assert not out.exists() and not Path(str(out) + ".tmp").exists()
+        assert not list(tmp_path.glob("*merged.json*"))  # no output, no temporary file
+
+
+def test_an_output_it_cannot_write_is_one_line(tmp_path):
+    a = part(tmp_path, "a", ["r/x"], "d1")
+    out = tmp_path / "no such folder" / "merged.json"
+    r = run(out, a)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "merged.json" in r.stderr, r.stderr
+    assert not out.parent.exists()
 
 
 def test_usage_without_parts(tmp_path):
