@@ -10,7 +10,8 @@
 # Writes OUT_DIR/bench-scaling-NAME.json, its console (.txt) and the GPU's state before and after.
 set -uo pipefail
 usage="usage: scripts/device/gpu_bench_scaling.sh OUT_DIR NAME FILTER"
-out=${1:?$usage}; name=${2:?$usage}; filter=${3:?$usage}
+if [ $# -ne 3 ] || [ -z "$1" ] || [ -z "$3" ]; then echo "$usage" >&2; exit 2; fi
+out=$1; name=$2; filter=$3
 [[ $name =~ ^[A-Za-z0-9_-]+$ ]] || { echo "gpu_bench_scaling.sh: NAME '$name': letters, digits, - and _ only" >&2; exit 2; }
 mkdir -p "$out" && out=$(realpath "$out")
 cd "$(dirname "${BASH_SOURCE[0]}")/../.." || exit 1

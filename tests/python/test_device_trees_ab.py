@@ -34,9 +34,10 @@ SCALING = ROOT / "scripts" / "device" / "gpu_bench_scaling.sh"
 
 def test_bench_scaling_refuses_a_name_it_would_write_as_a_path(tmp_path):
     # NAME becomes part of file names under OUT_DIR: a slash or a space could write elsewhere.
-    for name in ["../x", "a b", "x/y", ""]:
-        r = subprocess.run(["bash", str(SCALING), str(tmp_path / "out"), name, "gpu/pixel/"], capture_output=True,
+    for args in [["../x", "gpu/pixel/"], ["a b", "gpu/pixel/"], ["x/y", "gpu/pixel/"], ["", "gpu/pixel/"], ["x", ""],
+                 ["x"]]:
+        r = subprocess.run(["bash", str(SCALING), str(tmp_path / "out"), *args], capture_output=True,
                            text=True, timeout=60)
-        assert r.returncode != 0, (name, r.stdout, r.stderr)
+        assert r.returncode == 2, (args, r.stdout, r.stderr)
         assert len(r.stderr.strip().splitlines()) == 1, r.stderr
         assert not (tmp_path / "out").exists()
