@@ -1,6 +1,6 @@
 // The binary BVH's any-hit (shadow) walks take the farther child first (binary_bvh.h,
 // traverse's kFarFirst): the same answers as the closest-hit walk's, segment by segment,
-// through other nodes than the nearer-first walk's. (The two-level BVH's: test_two_level.cpp.) Plain C++ (label unit); the device runs
+// through other nodes than the nearer-first walk's. Plain C++ (label unit); the device runs
 // the same function (GpuSlab and GpuTraversal check its any-hits against the host's).
 #include <gtest/gtest.h>
 
