@@ -1,6 +1,8 @@
-// The pixel strategy: one megakernel, one thread per pixel sample (a warp takes chunks of
-// 32 consecutive samples from a counter), the whole path in registers. Samples of one
-// pixel are summed in the warp (exact integer sums) before one atomic per pixel.
+// The pixel strategy: one megakernel, one thread per pixel sample (a warp takes chunks of 32
+// consecutive samples from a counter, or, for large flat BVHs, units of up to 256 samples of
+// one pixel traced 32 at a time grouped by their first bounce's random numbers:
+// sample_order.cuh), the whole path in registers. Samples of
+// one pixel are summed in the warp (exact integer sums) before one atomic per pixel.
 #include <cuda_runtime.h>
 #include <fmt/core.h>
 
@@ -12,6 +14,7 @@
 #include "gpu_scene_impl.cuh"
 #include "kernel_sync.h"
 #include "path_step.cuh"
+#include "sample_order.cuh"
 #include "pathbench/bvh/traversal.h"
 #include "pathbench/common/errors.h"
 #include "strategies.cuh"
@@ -63,16 +66,25 @@ static_assert(sizeof(ParkedPath<float>) == 100, "25 words: an odd stride in word
 // the parked state's shared arrays are sized for it.
 constexpr int kPixelMaxBlock = 256;
 
+// Whether k_pixel orders a unit's samples by their first bounce (sample_order.cuh): only the
+// binary and wide BVHs' latency-bound kernels (more than 3 blocks). Measured interleaved on an
+// H200 against chunks of 32 in sample order (docs/notes/gpu-log.md, "Lanes ordered by the first
+// bounce"): bunny-armadillo 0.974, paper-cornell-ico:8 0.965, large-mesh 0.990, glass-dragon 0.999,
+// bunny-armadillo in wide8 0.933; slower where a kernel is issue bound or the BVH is not one
+// flat tree: cornell-materials and the Mitsuba box (binary, 3 blocks) 1.027 and 1.026,
+// paper-cornell (rects) 1.19-1.25, instanced (two-level) 1.243.
+constexpr bool lanes_ordered(int kind, int blocks) {
+  return (kind == int(TraversalKind::Binary) || kind == int(TraversalKind::Wide)) && blocks > 3;
+}
+
 template <bool kVariance, uint32_t Kinds, class T, bool kWatertight, int kKind, int kMinBlocks, bool kParked = false>
 __global__ void __launch_bounds__(kPixelMaxBlock, kMinBlocks) k_pixel(SceneView s, BvhView bvh, PathConfig c, uint64_t total,
                                                FilmDev film, PixelCounters* ctr) {
   kernel_prologue();
   const uint32_t lane = threadIdx.x & 31;
   uint32_t n_bounce = 0, n_shadow = 0, n_paths = 0;
-  // Every chunk of 32 samples from the counter (work_chunks.cuh).
-  auto chunk = [&](unsigned long long k) {
-    const uint64_t g = k * 32 + lane;
-    const bool valid = g < total;
+  // Sample g of the launch on this lane (or none: !valid), then the warp's sums into the film.
+  auto trace = [&](bool valid, uint64_t g) {
     const uint32_t pixel = valid ? c.first_pixel + uint32_t(g / c.spp) : kNoPixel;
     Vec3f L{0.0f, 0.0f, 0.0f};
     if (valid) {
@@ -88,10 +100,40 @@ __global__ void __launch_bounds__(kPixelMaxBlock, kMinBlocks) k_pixel(SceneView 
     }
     film_add_warp<kVariance>(film, valid, pixel, L, &ctr->stats.discarded);
   };
-  // Parked: the chunk loop's state in shared memory too (for_each_chunk_parked), not in four
-  // registers live through every traversal.
-  if constexpr (kParked) for_each_chunk_parked<kPixelMaxBlock / 32, unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
-  else for_each_chunk<unsigned long long>((total + 31) / 32, 0ull, &ctr->chunks, chunk);
+  // Every unit of work from the counter (work_chunks.cuh). Parked: the loop's state in shared
+  // memory too (for_each_chunk_parked), not in four registers live through every traversal.
+  auto each = [&](unsigned long long n, auto&& work) {
+    if constexpr (kParked) for_each_chunk_parked<kPixelMaxBlock / 32, unsigned long long>(n, 0ull, &ctr->chunks, work);
+    else for_each_chunk<unsigned long long>(n, 0ull, &ctr->chunks, work);
+  };
+  if constexpr (lanes_ordered(kKind, kMinBlocks)) {
+    // Units of up to kOrderGroup samples of one pixel, traced 32 at a time in the order of
+    // their first bounce's numbers (sample_order.cuh), or 32 in sample order where spp is small.
+    // The unit (warp-uniform) waits in shared memory, not in registers live through the traversals
+    // (ptxas, sm_90, binary at 8 blocks: 704 -> 788 bytes of spill stores with it in registers).
+    __shared__ uint16_t order[kPixelMaxBlock / 32][kOrderGroup];
+    __shared__ uint32_t counts[kPixelMaxBlock / 32][kOrderBins];
+    __shared__ SampleUnit units_now[kPixelMaxBlock / 32];
+    each(sample_units(total, c.spp), [&](unsigned long long k) {
+      {
+        const SampleUnit u = sample_unit(total, c.spp, k);
+        if (lane == 0) units_now[threadIdx.x >> 5] = u;
+        if (order_samples(c.spp)) order_unit(c, u, order[threadIdx.x >> 5], counts[threadIdx.x >> 5]);
+        __syncwarp();
+      }
+      // Read through volatile at each use, so that the compiler reloads them instead of keeping
+      // them in registers.
+      const volatile SampleUnit* now = &units_now[threadIdx.x >> 5];
+      for (uint32_t base = 0; base < now->count; base += 32) {
+        const uint32_t e = base + lane;
+        const bool valid = e < now->count;
+        trace(valid, now->g0 + (order_samples(c.spp) && valid ? order[threadIdx.x >> 5][e] : e));
+      }
+    });
+  } else {
+    // Chunks of 32 consecutive samples.
+    each((total + 31) / 32, [&](unsigned long long k) { trace(k * 32 + lane < total, k * 32 + lane); });
+  }
   block_stats_add(&ctr->stats, n_bounce, n_shadow, n_paths);
 }
 
@@ -166,6 +208,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes) {
   } else if (o.parked) {
     o.why += "; path state parked in shared memory";
   }
+  o.lanes_ordered = with_traversal_kind(g.bvh, [&](auto kind) { return lanes_ordered(decltype(kind)::value, o.min_blocks); });
   return o;
 }
 
@@ -179,9 +222,10 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
   // Moeller-Trumbore, switching on it at the compiler's occupancy.
   with_features(g.view.material_kinds, [&](auto kinds) {
     constexpr uint32_t K = decltype(kinds)::value;
-    // A thread a sample at most: a small frame leaves no warp without a chunk.
-    const uint64_t threads = (total + 31) / 32 * 32;
-    auto go = [&](auto kernel) {
+    // A warp a unit of samples at most (a chunk of 32, or sample_order.cuh's): a small frame
+    // leaves no warp without one.
+    auto go = [&](auto kernel, bool ordered = false) {
+      const uint64_t threads = (ordered ? sample_units(total, c.spp) : (total + 31) / 32) * 32;
       launch.launch_persistent("pixel", kernel, threads, g.view, g.bvh, c, total, film, counters.get());
     };
     constexpr int kAny = kAnyKind;
@@ -192,10 +236,11 @@ FrameResult run_pixel(Launcher& launch, cudaStream_t stream, const GpuScene::Imp
         constexpr int B = decltype(kind)::value;
         auto at = [&](auto blocks) {
           constexpr int N = decltype(blocks)::value;
+          constexpr bool O = lanes_ordered(B, N);
           if constexpr (parked_compiled(B, N)) {  // pixel_occupancy says where it runs
-            if (parked) return variance ? go(k_pixel<true, K, float, true, B, N, true>) : go(k_pixel<false, K, float, true, B, N, true>);
+            if (parked) return variance ? go(k_pixel<true, K, float, true, B, N, true>, O) : go(k_pixel<false, K, float, true, B, N, true>, O);
           }
-          variance ? go(k_pixel<true, K, float, true, B, N>) : go(k_pixel<false, K, float, true, B, N>);
+          variance ? go(k_pixel<true, K, float, true, B, N>, O) : go(k_pixel<false, K, float, true, B, N>, O);
         };
         if constexpr (compiled_for_five_blocks(B)) {
           if (min_blocks == 5) return at(std::integral_constant<int, 5>{});

@@ -27,6 +27,7 @@
 #include "gpu_scene_impl.cuh"
 #include "path_pool.cuh"
 #include "render_cache.cuh"
+#include "pathbench/bvh/sample_units.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "strategies.cuh"
@@ -373,7 +374,8 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
     x["pixel_block"] = su.launch.block_size("pixel");
     if (settings.precision == Precision::Float && settings.watertight)
       x["pixel_occupancy"] = {{"min_blocks_per_sm", su.occupancy.min_blocks}, {"why", su.occupancy.why},
-                              {"parked_path_state", su.occupancy.parked}};
+                              {"parked_path_state", su.occupancy.parked},
+                              {"lanes_ordered_by_first_bounce", su.occupancy.lanes_ordered && bvh::order_samples(settings.spp)}};
   }
   if (profile) {
     const nlohmann::json prof = su.launch.collect();

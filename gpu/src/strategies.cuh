@@ -54,6 +54,9 @@ struct PixelOccupancy {
   // large-mesh, 1.018 on bunny-armadillo and 1.045 on glass-dragon (it takes 205 KB of an
   // SM's L1).
   bool parked = false;
+  // The kernel that runs orders a pixel's samples by their first bounce, from
+  // bvh::kOrderMinSpp samples a pixel on (pixel.cu: lanes_ordered; sample_order.cuh).
+  bool lanes_ordered = false;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
 // The latency-bound build: 8 blocks (32 registers, ~700 bytes of spills) since the slab

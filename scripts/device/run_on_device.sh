@@ -83,6 +83,15 @@ if has sanitize; then
       echo "rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' $OUT/logs/sanitizer-$tool-$st.txt)" | tee -a "$OUT/summary.txt"
     done
   done
+  # The pixel megakernel's lanes ordered by the first bounce (sample_order.cuh: a counting sort
+  # in shared memory): the binary BVH at 8 blocks, 300 spp (units of 256 and of 44).
+  ordered="--scene paper-cornell-ico:2 --width 8 --height 8 --spp 300 --bounces 2 --sampling nee --device gpu --quiet"
+  for tool in memcheck racecheck; do
+    log "compute-sanitizer $tool pixel, lanes ordered"
+    PATHBENCH_GPU_BVH=binary PATHBENCH_GPU_PIXEL_BLOCKS=8 timeout 120 compute-sanitizer --tool $tool --print-limit 20 \
+      $PB render $ordered --strategy pixel > "$OUT/logs/sanitizer-$tool-pixel-ordered.txt" 2>&1
+    echo "rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' $OUT/logs/sanitizer-$tool-pixel-ordered.txt)" | tee -a "$OUT/summary.txt"
+  done
   # Whole warps of one pixel (spp a multiple of 32: the film add by REDUX, device_film.cuh).
   for st in pixel wavefront; do
     log "compute-sanitizer memcheck $st, 64 spp"

@@ -12,6 +12,7 @@
 #include "pathbench/bvh/bvh_build.h"
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/host_tracer.h"
+#include "pathbench/bvh/sample_units.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/gpu/render.h"
@@ -245,6 +246,52 @@ TEST(GpuPixelOccupancy, BigBinaryBvhParkedAtSixBlocks) {
     ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
     ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   }
+}
+
+// The binary and wide BVHs' latency-bound megakernels (more than 3 blocks) trace a pixel's
+// samples in units of up to 256 grouped by their first bounce (sample_order.cuh) from
+// kOrderMinSpp samples a pixel on; at 3 blocks, and below that spp, chunks of 32 in sample order.
+// Only which samples share a warp changes and the film sums integers: the same film bit for bit
+// (300 spp: units of 256 and of 44), parked or not, and the report says which order ran.
+TEST(GpuPixelLaneOrder, SameFilmAsSampleOrder) {
+  PB_REQUIRE_GPU();
+  auto ordered_of = [](const RunReport& r) { return r.extra["pixel_occupancy"]["lanes_ordered_by_first_bounce"].get<bool>(); };
+  const Scene scene = load_scene("paper-cornell-ico:3");
+  RenderSettings s = small_settings(Strategy::Pixel, 12, 300);
+  s.variance = true;
+  for (const GpuBvhLayout layout : {GpuBvhLayout::Binary, GpuBvhLayout::Wide8}) {
+    GpuBvhOptions o;
+    o.layout = layout;
+    const GpuScene gs(scene, o);
+    const std::string name = to_string(layout);
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "0", 1);
+    ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", "3", 1);
+    RunReport r;
+    const Film in_order = render_gpu(scene, gs, s, &r);
+    EXPECT_FALSE(ordered_of(r)) << name << " at 3 blocks";
+    const bool binary = layout == GpuBvhLayout::Binary;
+    for (const char* blocks : {"5", "6", "8"}) {
+      if (!binary && std::string(blocks) == "6") continue;  // compiled for the binary BVH only
+      for (const char* parked : {"0", "1"}) {
+        if (!binary && std::string(parked) == "1") continue;
+        ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", blocks, 1);
+        ::setenv("PATHBENCH_GPU_PIXEL_PARKED", parked, 1);
+        const std::string what = name + " at " + blocks + " blocks, parked " + parked;
+        expect_identical(in_order, render_gpu(scene, gs, s, &r), what.c_str());
+        EXPECT_TRUE(ordered_of(r)) << what;
+        EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], std::stoi(blocks)) << what;
+      }
+    }
+  }
+  RenderSettings few = s;
+  few.spp = bvh::kOrderMinSpp - 1;
+  const GpuScene gs(scene);
+  ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", "8", 1);
+  RunReport r;
+  render_gpu(scene, gs, few, &r);
+  EXPECT_FALSE(ordered_of(r)) << few.spp << " spp: chunks of 32 in sample order";
+  ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
+  ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
 }
 
 // GPU against the CPU tracer, same seed and settings: with one random stream the
