@@ -116,6 +116,9 @@ __global__ void __launch_bounds__(kPixelMaxBlock, kMinBlocks) k_pixel(SceneView 
     __shared__ SampleUnit units_now[kPixelMaxBlock / 32];
     each(sample_units(total, c.spp), [&](unsigned long long k) {
       {
+        // Every lane's last read of the unit before (the loop's end test) before its slot is
+        // overwritten (racecheck found the hazard).
+        __syncwarp();
         const SampleUnit u = sample_unit(total, c.spp, k);
         if (lane == 0) units_now[threadIdx.x >> 5] = u;
         if (order_samples(c.spp)) order_unit(c, u, order[threadIdx.x >> 5], counts[threadIdx.x >> 5]);
