@@ -194,7 +194,7 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big) {
 }
 }  // namespace
 
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes) {
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp) {
   const bool big = big_binary_bvh(g, l2_bytes);
   PixelOccupancy o = pixel_blocks(g, big);
   const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
@@ -211,7 +211,8 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes) {
   } else if (o.parked) {
     o.why += "; path state parked in shared memory";
   }
-  o.lanes_ordered = with_traversal_kind(g.bvh, [&](auto kind) { return lanes_ordered(decltype(kind)::value, o.min_blocks); });
+  o.lanes_ordered = order_samples(spp) &&
+                    with_traversal_kind(g.bvh, [&](auto kind) { return lanes_ordered(decltype(kind)::value, o.min_blocks); });
   return o;
 }
 

@@ -27,7 +27,6 @@
 #include "gpu_scene_impl.cuh"
 #include "path_pool.cuh"
 #include "render_cache.cuh"
-#include "pathbench/bvh/sample_units.h"
 #include "pathbench/common/errors.h"
 #include "pathbench/common/path.h"
 #include "strategies.cuh"
@@ -239,7 +238,7 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
     warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
   }
 
-  occupancy = s.strategy == Strategy::Pixel ? pixel_occupancy(g, info.l2_bytes) : PixelOccupancy{};
+  occupancy = s.strategy == Strategy::Pixel ? pixel_occupancy(g, info.l2_bytes, s.spp) : PixelOccupancy{};
   pool_stream_ids.push_back(stream);
   for (const auto& pool : *pools) pool_ptrs.push_back(pool.get());
   for (const auto& ps : *pool_streams) pool_stream_ids.push_back(ps->s);
@@ -374,8 +373,7 @@ void fill_report(RenderSetup& su, const TimedFrame& t, const Film& film, bool pr
     x["pixel_block"] = su.launch.block_size("pixel");
     if (settings.precision == Precision::Float && settings.watertight)
       x["pixel_occupancy"] = {{"min_blocks_per_sm", su.occupancy.min_blocks}, {"why", su.occupancy.why},
-                              {"parked_path_state", su.occupancy.parked},
-                              {"lanes_ordered_by_first_bounce", su.occupancy.lanes_ordered && bvh::order_samples(settings.spp)}};
+                              {"parked_path_state", su.occupancy.parked}, {"lanes_ordered_by_first_bounce", su.occupancy.lanes_ordered}};
   }
   if (profile) {
     const nlohmann::json prof = su.launch.collect();

@@ -54,8 +54,8 @@ struct PixelOccupancy {
   // large-mesh, 1.018 on bunny-armadillo and 1.045 on glass-dragon (it takes 205 KB of an
   // SM's L1).
   bool parked = false;
-  // The kernel that runs orders a pixel's samples by their first bounce, from
-  // bvh::kOrderMinSpp samples a pixel on (pixel.cu: lanes_ordered; sample_order.cuh).
+  // The kernel that runs orders a pixel's samples by their first bounce (pixel.cu:
+  // lanes_ordered; sample_order.cuh), and the frame has bvh::kOrderMinSpp samples a pixel or more.
   bool lanes_ordered = false;
 };
 constexpr uint32_t kPixelLatencyBoundTris = 16384;
@@ -88,8 +88,9 @@ constexpr int kWideLatencyBlocks = 5;
 // blocks 10.645 ms, at 4 10.749, at 5 10.454; parked at 3 (64 registers: 4 blocks run)
 // 10.245, parked at 5 (48 registers, 100 / 84 bytes spilled) 10.131.
 constexpr int kLeavesParkedBlocks = 5;
-// l2_bytes: the device's L2 (RenderSetup's DeviceInfo, the cache's copy where one is kept).
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes);
+// l2_bytes: the device's L2 (RenderSetup's DeviceInfo, the cache's copy where one is kept); spp:
+// the frame's samples a pixel (PixelOccupancy::lanes_ordered).
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from
 // a counter (work_chunks.cuh): more where traversals diverge (from kPixelLatencyBoundTris
