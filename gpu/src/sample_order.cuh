@@ -3,10 +3,11 @@
 // numbers, so that a warp's rays leave the first hit in similar directions and walk the BVH
 // through similar nodes. Only which samples share a warp changes: every sample is traced
 // as before and the film adds exact integer sums, so the film is the same bit for bit.
-// A host model of the walks on SIMT lanes (results/amd-epyc/archive/warp-models-36776c4; the
-// while-while model, whose effects were about twice the H100's when it was checked) gave
+// A host model of the walks on SIMT lanes (results/amd-epyc/archive/warp-models-36776c4) gave
 // bunny-armadillo 0.861 and paper-cornell-ico:8 0.815 of the warps' walk steps for groups of
-// 256 samples in 16 bins, glass-dragon (8 bounces) 0.965, cornell-materials 0.930.
+// 256 samples in 16 bins; an H200 gave about a fifth of that, 0.973 and 0.958 of the time
+// (results/nvidia-h200/archive/record-e024919), and was slower with 512 samples a group
+// (tests-10fdac3) and where the kernel is issue bound: pixel.cu's lanes_ordered says where it runs.
 #include <cuda_runtime.h>
 
 #include <cstdint>
