@@ -15,7 +15,7 @@ cases=${2:?usage: scripts/device/gpu_variants_ab.sh VARIANTS CASES OUT_DIR}
 out=${3:?usage: scripts/device/gpu_variants_ab.sh VARIANTS CASES OUT_DIR}
 mkdir -p "$out/films"
 tsv="$out/variants.tsv"
-echo -e "case\tround\tvariant\tdevice_ms\tfilm_sha\tblocks\tparked\tbvh" > "$tsv"
+echo -e "case\tround\tvariant\tdevice_ms\tfilm_sha\tblocks\tparked\tordered\tbvh" > "$tsv"
 trim() { local s=$1; s=${s#"${s%%[![:space:]]*}"}; echo "${s%"${s##*[![:space:]]}"}"; }
 while IFS='|' read -r cname rounds which opts; do
   cname=$(trim "$cname"); rounds=$(trim "$rounds"); which=$(trim "$which")
@@ -36,6 +36,7 @@ r = json.load(open(sys.argv[1]))
 occ = r.get("pixel_occupancy") or {}
 print("\t".join([sys.argv[2], sys.argv[3], sys.argv[4], f"{r['device_seconds'] * 1e3:.4f}", sys.argv[5],
                  str(occ.get("min_blocks_per_sm", "")), str(occ.get("parked_path_state", "")),
+                 str(occ.get("lanes_ordered_by_first_bounce", "")),
                  "{layout} {nodes} nodes {triangle_refs} refs depth {depth} SAH {sah_cost:.2f} {build_seconds:.2f} s".format(
                      **{"layout": "?", "nodes": 0, "triangle_refs": 0, "depth": 0, "sah_cost": 0.0, "build_seconds": 0.0,
                         **r.get("bvh", {})})]))
@@ -52,7 +53,7 @@ for case in dict.fromkeys(r["case"] for r in rows):
     for v in dict.fromkeys(r["variant"] for r in mine):
         ms = [float(r["device_ms"]) for r in mine if r["variant"] == v]
         films = sorted({r["film_sha"] for r in mine if r["variant"] == v})
-        occ = {(r["blocks"], r["parked"]) for r in mine if r["variant"] == v}
+        occ = {(r["blocks"], r["parked"], r["ordered"]) for r in mine if r["variant"] == v}
         med = statistics.median(ms)
         first = first or med
         bvh = sorted({r["bvh"] for r in mine if r["variant"] == v})
