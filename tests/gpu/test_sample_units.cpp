@@ -1,8 +1,9 @@
 // The pixel megakernel's units of samples (bvh/sample_units.h): every sample of a launch in
 // exactly one unit, a unit never crossing a pixel where its samples are ordered, and the
 // first bounce's bins spread over all 16. Plain C++ (label unit); the device's ordering of each
-// unit is checked by the films (GpuStrategies: the pixel strategy's film equals the
-// wavefront's, bit for bit).
+// unit is checked by the films (test_gpu.cpp, GpuPixelLaneOrder: the ordered kernels' films
+// equal the 3-block kernel's in sample order, bit for bit; GpuStrategies' small frames do not
+// reach the ordered kernels).
 #include <gtest/gtest.h>
 
 #include <vector>
