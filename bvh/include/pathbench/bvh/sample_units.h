@@ -23,16 +23,17 @@ struct SampleUnit {
 // Ordered: units are groups of up to kOrderGroup samples that never cross a pixel; else chunks
 // of 32 consecutive samples (small spp: a group would hold too few samples to order).
 PB_HD bool order_samples(uint32_t spp) { return spp >= kOrderMinSpp; }
+// Ordered units a pixel's samples take (the last one may be short).
+PB_HD uint64_t units_per_pixel(uint32_t spp) { return (uint64_t(spp) + kOrderGroup - 1) / kOrderGroup; }
 PB_HD uint64_t sample_units(uint64_t total, uint32_t spp) {
   if (!order_samples(spp)) return (total + 31) / 32;
-  const uint64_t per_pixel = (spp + kOrderGroup - 1) / kOrderGroup, rest = total % spp;
-  return total / spp * per_pixel + (rest + kOrderGroup - 1) / kOrderGroup;
+  return total / spp * units_per_pixel(spp) + units_per_pixel(uint32_t(total % spp));
 }
 PB_HD SampleUnit sample_unit(uint64_t total, uint32_t spp, uint64_t k) {
   uint64_t g0 = k * 32;
   uint32_t most = 32;
   if (order_samples(spp)) {
-    const uint64_t per_pixel = (spp + kOrderGroup - 1) / kOrderGroup, j = k % per_pixel;
+    const uint64_t per_pixel = units_per_pixel(spp), j = k % per_pixel;
     g0 = k / per_pixel * spp + j * kOrderGroup;
     most = uint32_t(spp - j * kOrderGroup < kOrderGroup ? spp - j * kOrderGroup : kOrderGroup);
   }
