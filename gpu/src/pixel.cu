@@ -142,7 +142,7 @@ __global__ void __launch_bounds__(kPixelMaxBlock, kMinBlocks) k_pixel(SceneView 
 
 // The counts k_pixel is compiled for (float, watertight): 3 and kPixelLatencyBlocks for every
 // layout, 5 too for the wide, leaves, rects and binary layouts (kWideLatencyBlocks,
-// kLeavesParkedBlocks, the binary BVH's opt-in), 6 for the binary layout (kPixelBigBvhBlocks);
+// kLeavesParkedBlocks, kLongPathBlocks), 6 for the binary layout (kPixelBigBvhBlocks);
 // the parked path state for the leaves layout at every count but kPixelLatencyBlocks and the
 // binary BVH's at 5, 6 and 8. run_pixel
 // dispatches on these, pixel_blocks and pixel_occupancy choose within them.
@@ -155,7 +155,8 @@ constexpr bool parked_compiled(int kind, int blocks) {
   return ((kind == int(TraversalKind::Leaves) || kind == int(TraversalKind::Rects)) && blocks != kPixelLatencyBlocks) ||
          (kind == int(TraversalKind::Binary) && blocks >= 5);
 }
-static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kPixelLatencyBlocks == 8 && kPixelBigBvhBlocks == 6,
+static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kLongPathBlocks == 5 && kPixelLatencyBlocks == 8 &&
+                  kPixelBigBvhBlocks == 6,
               "the counts compiled: 3, 5 and 8, and 6 for the binary BVH");
 
 // The scene's BVH exceeds the device's L2 of l2_bytes (the binary layout's nodes and
@@ -166,44 +167,63 @@ bool big_binary_bvh(const GpuScene::Impl& g, uint64_t l2_bytes) {
   return g.bvh_bytes > l2_bytes;
 }
 
-// The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size gives (pixel_occupancy; `big`:
-// big_binary_bvh).
-PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big) {
-  const bool wide = g.bvh.kind == TraversalKind::Wide;
+// The traversal kind of the kernel run_pixel runs for the scene (with_traversal_kind: a binary
+// BVH with exact ties has kernels of its own), which the counts compiled are checked against.
+int kernel_kind(const GpuScene::Impl& g) {
+  return with_traversal_kind(g.bvh, [](auto k) { return int(decltype(k)::value); });
+}
+
+// The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size and paths give (pixel_occupancy;
+// `big`: big_binary_bvh; `bounces`: the frame's, -1 unbounded).
+PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big, int32_t bounces) {
+  const int kind = kernel_kind(g);
+  const bool wide = kind == int(TraversalKind::Wide), binary = kind == int(TraversalKind::Binary);
   const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   const std::string v = env ? env : "auto";
   if (v != "auto") {
     const bool ok = v == "3" || v == std::to_string(kPixelLatencyBlocks) ||
-                    (compiled_for_five_blocks(int(g.bvh.kind)) && v == "5") ||
-                    (compiled_for_six_blocks(int(g.bvh.kind)) && v == std::to_string(kPixelBigBvhBlocks));
+                    (compiled_for_five_blocks(kind) && v == "5") ||
+                    (compiled_for_six_blocks(kind) && v == std::to_string(kPixelBigBvhBlocks));
     if (!ok)
       throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_BLOCKS={}: expected auto, 3 or {} (the wide BVH layouts: "
                                    "auto, 3, 5 or 8; the leaves and rects layouts: also 5; the binary layout: also 5 "
-                                   "and {})", v, kPixelLatencyBlocks, kPixelBigBvhBlocks));
+                                   "and {}, but not for a scene with instances traced flat)",
+                                   v, kPixelLatencyBlocks, kPixelBigBvhBlocks));
     return {std::stoi(v), "PATHBENCH_GPU_PIXEL_BLOCKS=" + v};
   }
   if (big)
     return {kPixelBigBvhBlocks,
             fmt::format("auto: the binary BVH's {:.1f} MB exceed the L2: {} blocks", double(g.bvh_bytes) / 1e6,
                         kPixelBigBvhBlocks)};
-  if (g.bvh_tris >= kPixelLatencyBoundTris)
+  // Long paths (strategies.cuh, kLongPathBlocks): measured on the binary BVH only.
+  const auto long_paths = [&](int32_t from) { return binary && (bounces < 0 || bounces >= from); };
+  const std::string paths = bounces < 0 ? "unbounded paths" : fmt::format("paths of {} bounces", bounces);
+  if (g.bvh_tris >= kPixelLatencyBoundTris) {
+    if (long_paths(kLongPathLatencyBounces))
+      return {kLongPathBlocks, fmt::format("auto: {} triangles >= {}, {} (>= {}): {} blocks", g.bvh_tris,
+                                           kPixelLatencyBoundTris, paths, kLongPathLatencyBounces, kLongPathBlocks)};
     return {latency, fmt::format("auto: {} triangles >= {} (latency bound: more warps{})", g.bvh_tris,
                                  kPixelLatencyBoundTris, wide ? "; the wide BVH's count" : "")};
+  }
+  if (long_paths(kLongPathBounces))
+    return {kLongPathBlocks, fmt::format("auto: {} triangles < {}, {} (>= {}): {} blocks", g.bvh_tris,
+                                         kPixelLatencyBoundTris, paths, kLongPathBounces, kLongPathBlocks)};
   return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
 }
 }  // namespace
 
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp) {
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp, int32_t bounces) {
   const bool big = big_binary_bvh(g, l2_bytes);
-  PixelOccupancy o = pixel_blocks(g, big);
+  PixelOccupancy o = pixel_blocks(g, big, bounces);
   const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
   const std::string v = env ? env : "auto";
   if (v == "auto") o.parked = leaves || (o.min_blocks == kPixelBigBvhBlocks && big);
   else if (v == "0" || v == "1") o.parked = v == "1";
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
-  if (o.parked && !parked_compiled(int(g.bvh.kind), o.min_blocks)) o.parked = false;
+  const int kind = kernel_kind(g);
+  if (o.parked && !parked_compiled(kind, o.min_blocks)) o.parked = false;
   const char* blocks = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
     o.min_blocks = kLeavesParkedBlocks;
@@ -211,8 +231,7 @@ PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint3
   } else if (o.parked) {
     o.why += "; path state parked in shared memory";
   }
-  o.lanes_ordered = order_samples(spp) &&
-                    with_traversal_kind(g.bvh, [&](auto kind) { return lanes_ordered(decltype(kind)::value, o.min_blocks); });
+  o.lanes_ordered = order_samples(spp) && lanes_ordered(kind, o.min_blocks);
   return o;
 }
 

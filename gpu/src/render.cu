@@ -238,7 +238,7 @@ RenderSetup::RenderSetup(const Scene& scene, const GpuScene& gpu_scene, const Re
     warmup_total = total;  // its warm-up is the frame itself: the queue is sized for it
   }
 
-  occupancy = s.strategy == Strategy::Pixel ? pixel_occupancy(g, info.l2_bytes, s.spp) : PixelOccupancy{};
+  occupancy = s.strategy == Strategy::Pixel ? pixel_occupancy(g, info.l2_bytes, s.spp, s.max_bounces) : PixelOccupancy{};
   pool_stream_ids.push_back(stream);
   for (const auto& pool : *pools) pool_ptrs.push_back(pool.get());
   for (const auto& ps : *pool_streams) pool_stream_ids.push_back(ps->s);

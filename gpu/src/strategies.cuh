@@ -88,9 +88,25 @@ constexpr int kWideLatencyBlocks = 5;
 // blocks 10.645 ms, at 4 10.749, at 5 10.454; parked at 3 (64 registers: 4 blocks run)
 // 10.245, parked at 5 (48 registers, 100 / 84 bytes spilled) 10.131.
 constexpr int kLeavesParkedBlocks = 5;
+// Long paths: the binary BVH's megakernel at kLongPathBlocks (48 registers) from kLongPathBounces
+// bounces where auto would give it 3 (issue bound, below kPixelLatencyBoundTris), and from
+// kLongPathLatencyBounces where it would give kPixelLatencyBlocks; unbounded paths count as long.
+// A BVH larger than the L2 keeps kPixelBigBvhBlocks. Each path's later bounces go their own ways,
+// and more warps hide that better than 3 blocks' registers do. Interleaved on an H200,
+// 256x256x800 nee, the same films (docs/notes/gpu-log.md, "Long paths at 5 blocks"), 5 blocks
+// against auto's count before:
+//   3 blocks: cornell-box at 2 bounces 1.064, 3 1.002, 4 0.963, 5 0.934, 8 0.906 (uniform 0.920);
+//     cornell-materials 1.019 / 0.958 / 0.931 at 2 / 3 / 4, 0.884 at 8, 0.856 at 16; cornell-box
+//     glass, mirror, ggx at 8: 0.911, 0.920, 0.890; paper-cornell-ico:3 at 4 and 8: 0.940, 0.942;
+//   8 blocks: paper-cornell-ico:5 at 4 and 8: 0.967, 0.965; bunny-armadillo 1.009 at 4, 0.979 at 8;
+//     glass-dragon at 8 0.986;
+//   6 parked (above the L2) at 8 bounces: ico:8 1.060, large-mesh 1.082: kept.
+constexpr int kLongPathBlocks = 5;
+constexpr int32_t kLongPathBounces = 4, kLongPathLatencyBounces = 8;
 // l2_bytes: the device's L2 (RenderSetup's DeviceInfo, the cache's copy where one is kept); spp:
-// the frame's samples a pixel (PixelOccupancy::lanes_ordered).
-PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp);
+// the frame's samples a pixel (PixelOccupancy::lanes_ordered); bounces: the frame's max_bounces
+// (-1: unbounded).
+PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp, int32_t bounces);
 
 // How many of the last full rounds of a wavefront stage's grid stride its warps take from
 // a counter (work_chunks.cuh): more where traversals diverge (from kPixelLatencyBoundTris

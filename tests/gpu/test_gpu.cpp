@@ -248,6 +248,40 @@ TEST(GpuPixelOccupancy, BigBinaryBvhParkedAtSixBlocks) {
   }
 }
 
+// auto's occupancy for long paths on the binary BVH (strategies.cuh: kLongPathBlocks 5, from
+// kLongPathBounces 4 bounces below kPixelLatencyBoundTris triangles, else 3; from
+// kLongPathLatencyBounces 8 above, else 8), unbounded paths counted long; a BVH beyond the L2
+// keeps kPixelBigBvhBlocks (6). The block count never changes the film.
+TEST(GpuPixelOccupancy, LongPathsAtFiveBlocks) {
+  PB_REQUIRE_GPU();
+  ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
+  ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  struct Case {
+    const char* scene;
+    int32_t bounces;
+    int blocks;
+  };
+  for (const Case& k : {Case{"cornell-box", 3, 3}, Case{"cornell-box", 4, 5}, Case{"cornell-box", -1, 5},
+                        Case{"paper-cornell-ico:5", 7, 8}, Case{"paper-cornell-ico:5", 8, 5},
+                        Case{"paper-cornell-ico:8", 8, 6}}) {
+    const Scene scene = load_scene(k.scene);
+    const GpuScene gs(scene);
+    RenderSettings s = small_settings(Strategy::Pixel, 16, 16);
+    s.max_bounces = k.bounces;
+    s.russian_roulette = k.bounces < 0;
+    const std::string what = std::string(k.scene) + " at " + std::to_string(k.bounces) + " bounces";
+    RunReport r;
+    const Film film = render_gpu(scene, gs, s, &r);
+    EXPECT_EQ(r.extra["bvh"]["layout"], "binary") << what;
+    EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], k.blocks) << what << ": " << r.extra["pixel_occupancy"]["why"];
+    ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", "3", 1);
+    ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "0", 1);
+    expect_identical(film, render_gpu(scene, gs, s), what.c_str());
+    ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
+    ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  }
+}
+
 // The binary and wide BVHs' latency-bound megakernels (more than 3 blocks) trace a pixel's
 // samples in units of up to 256 grouped by their first bounce (sample_order.cuh) from
 // kOrderMinSpp samples a pixel on; at 3 blocks, and below that spp, chunks of 32 in sample order.

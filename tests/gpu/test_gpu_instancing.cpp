@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "pathbench/bvh/bvh_layout.h"
 #include "pathbench/bvh/host_tracer.h"
+#include "pathbench/common/errors.h"
 #include "pathbench/scene_io/scene_library.h"
 #include "pathbench/gpu/render.h"
 #include "require_gpu.h"
@@ -73,6 +75,37 @@ TEST(GpuInstancing, FilmsEqualFlatAndHost) {
         }
       }
   }
+}
+
+// A scene with instances traced flat runs the binary BVH's exact-ties megakernels, compiled for
+// 3 and 8 blocks only (pixel.cu): PATHBENCH_GPU_PIXEL_BLOCKS=5 or 6 is refused, naming the
+// variable, where it once ran 3 blocks and reported the count asked; long paths leave auto at 3
+// (the 5-block rule is the plain binary BVH's).
+TEST(GpuInstancing, FlatBlocksAsCompiled) {
+  PB_REQUIRE_GPU();
+  const Scene scene = quiet_load("scenes/examples/instancing.json");
+  const GpuScene flat(scene, Instancing::Off);
+  RenderSettings s;
+  s.width = s.height = 16;
+  s.spp = 4;
+  s.max_bounces = 8;
+  s.device = Device::Gpu;
+  s.seed = 21;
+  s.progress = false;
+  RunReport r;
+  ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
+  gpu_film(scene, flat, s, r);
+  EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], 3) << r.extra["pixel_occupancy"]["why"];
+  for (const char* blocks : {"5", "6"}) {
+    ::setenv("PATHBENCH_GPU_PIXEL_BLOCKS", blocks, 1);
+    try {
+      gpu_film(scene, flat, s, r);
+      ADD_FAILURE() << "PATHBENCH_GPU_PIXEL_BLOCKS=" << blocks << ": no InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("PATHBENCH_GPU_PIXEL_BLOCKS"), std::string::npos) << e.what();
+    }
+  }
+  ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
 }
 
 TEST(GpuInstancing, DeviceTraversalAnswersAsTheHost) {
