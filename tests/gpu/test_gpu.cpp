@@ -19,6 +19,7 @@
 #include "require_gpu.h"
 #include "pathbench/run/run.h"
 #include "film_agreement.h"
+#include "refusal_check.h"
 #include "traversal_check.h"
 #if __has_include("../unit/stat_test.h")
 #include "../unit/stat_test.h"
@@ -51,20 +52,6 @@ Film render_gpu(const Scene& scene, const GpuScene& gs, RenderSettings s, RunRep
   EXPECT_EQ(r.discarded_samples, 0u);
   if (out) *out = r;
   return film;
-}
-
-// The render refuses the settings (an environment variable's value) with an InputError
-// naming `variable`.
-void expect_refused_naming(const Scene& scene, const GpuScene& gs, const RenderSettings& s, const char* variable) {
-  Film f(s.width, s.height, false);
-  RunReport r;
-  f.begin(s.spp, scene.max_emission());
-  try {
-    render(scene, gs, s, f, r, false);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(variable), std::string::npos) << e.what();
-  }
 }
 
 void expect_identical(const Film& a, const Film& b, const char* what) {
@@ -169,7 +156,7 @@ TEST(GpuWavefrontPools, BitIdenticalForAnyPoolCount) {
       EXPECT_EQ(r.extra["pools"], std::stoi(pools)) << what;
     }
   ::setenv("PATHBENCH_GPU_WAVEFRONT_POOLS", "5", 1);
-  expect_refused_naming(scene, gs, s, "PATHBENCH_GPU_WAVEFRONT_POOLS");
+  ::pb::test::expect_refused_naming(scene, gs, s, "PATHBENCH_GPU_WAVEFRONT_POOLS");
   ::unsetenv("PATHBENCH_GPU_WAVEFRONT_POOLS");
 }
 
@@ -213,7 +200,7 @@ TEST(GpuPixelParked, SameFilmAsInRegisters) {
       EXPECT_EQ(r.extra["pixel_occupancy"]["min_blocks_per_sm"], std::stoi(blocks)) << what;
     }
     ::setenv("PATHBENCH_GPU_PIXEL_PARKED", "yes", 1);
-    expect_refused_naming(scene, gs, s, "PATHBENCH_GPU_PIXEL_PARKED");
+    ::pb::test::expect_refused_naming(scene, gs, s, "PATHBENCH_GPU_PIXEL_PARKED");
   }
   ::unsetenv("PATHBENCH_GPU_PIXEL_PARKED");
   ::unsetenv("PATHBENCH_GPU_PIXEL_BLOCKS");
