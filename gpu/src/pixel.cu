@@ -209,7 +209,11 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big, int32_t bounces) 
   if (long_paths(kLongPathBounces))
     return {kLongPathBlocks, fmt::format("auto: {} triangles < {}, {} (>= {}): {} blocks", g.bvh_tris,
                                          kPixelLatencyBoundTris, paths, kLongPathBounces, kLongPathBlocks)};
-  return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris, kPixelLatencyBoundTris)};
+  if (binary && g.bvh_tris >= kPixelTinyTris)  // strategies.cuh: short paths over all but the tiniest BVHs
+    return {kPixelLatencyBlocks, fmt::format("auto: {} triangles >= {}, {} (< {}): {} blocks", g.bvh_tris,
+                                             kPixelTinyTris, paths, kLongPathBounces, kPixelLatencyBlocks)};
+  return {3, fmt::format("auto: {} triangles < {} (issue bound)", g.bvh_tris,
+                         binary ? kPixelTinyTris : kPixelLatencyBoundTris)};
 }
 }  // namespace
 

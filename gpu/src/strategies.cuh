@@ -38,7 +38,9 @@ struct ShadowUse {
 
 // The megakernel's occupancy: blocks of 256 threads an SM (registers capped to match),
 // and why. From kPixelLatencyBoundTris triangle references on, a scene's BVH misses L1
-// and the megakernel waits on memory (more warps hide it); below, it is issue bound.
+// and the megakernel waits on memory (more warps hide it); below, it was issue bound on an H100
+// at the time, but on an H200 today the binary BVH's short paths gain from more warps from
+// kPixelTinyTris on, and its long paths everywhere (kLongPathBlocks, below).
 // PATHBENCH_GPU_PIXEL_BLOCKS=auto|3|8 (5 too for the leaves and binary layouts, 6 for the binary)
 // overrides it (a bad value: InputError); the wide BVH's megakernel is compiled for 5 too
 // (pixel.cu: compiled_for_five_blocks).
@@ -103,6 +105,12 @@ constexpr int kLeavesParkedBlocks = 5;
 //   6 parked (above the L2) at 8 bounces: ico:8 1.060, large-mesh 1.082: kept.
 constexpr int kLongPathBlocks = 5;
 constexpr int32_t kLongPathBounces = 4, kLongPathLatencyBounces = 8;
+// Short paths (fewer than kLongPathBounces bounces) over a binary BVH below kPixelLatencyBoundTris:
+// kPixelLatencyBlocks from kPixelTinyTris triangles, 3 below. H200, 2 bounces, 8 blocks against 3
+// (docs/notes/gpu-log.md, "Long paths at 5 blocks"): paper-cornell-ico:1 (94 triangles) 0.960,
+// ico:2 (334) 0.954, ico:3 (1,294) 0.952, ico:4 (5,134) 0.924, ico:5 (20,494) 0.888; the tiniest
+// did not gain: cornell-box (38) 1.077, cornell-materials (50) 0.975 (5 blocks 1.064, 1.018).
+constexpr uint32_t kPixelTinyTris = 64;
 // l2_bytes: the device's L2 (RenderSetup's DeviceInfo, the cache's copy where one is kept); spp:
 // the frame's samples a pixel (PixelOccupancy::lanes_ordered); bounces: the frame's max_bounces
 // (-1: unbounded).
