@@ -23,6 +23,15 @@
 #   tar -C DIR -cf - . | xz -9e --lzma2=preset=9e,dict=192MiB > BINARIES/binaries.tar.xz
 # BUDGET_S (default 500) bounds the A/B itself, so that what ran comes back inside the
 # call's limit.
+# Checks of a build before its A/B, so that a call that tests a change needs no script of
+# its own:
+#   - BINARIES/pathbench_gpu_tests.xz (the GPU test binary, stripped, of the build named
+#     first in VARIANTS' tree): run first, whole, into $OUT/gpu-tests-LABEL.txt. Its tests
+#     read the tree through the source folder compiled into them, TESTS_SOURCE_DIR (default
+#     /work/main), which is linked to this checkout where the GPU host lacks it;
+#   - SANITIZE="render arguments": compute-sanitizer memcheck and racecheck of the first
+#     unpacked pathbench on that render, into $OUT/sanitizer-LABEL-TOOL.txt.
+# Their one-line outcomes lead $OUT/summary-LABEL.txt.
 set -uo pipefail
 usage="usage: scripts/device/gpu_binaries_ab.sh BINARIES RUNTIME_LIBS SUITE_DATA VARIANTS CASES LABEL"
 bins=${1:?$usage}
@@ -47,6 +56,7 @@ if [ ${#unpacked[@]} -eq 0 ]; then
 fi
 for f in "${unpacked[@]}"; do
   name=${f##*/pathbench-}
+  first=${first:-$name}
   mkdir -p "/tmp/pb/$name/bin"
   mv "$f" "/tmp/pb/$name/bin/pathbench" && chmod +x "/tmp/pb/$name/bin/pathbench" || exit 3
   if ldd "/tmp/pb/$name/bin/pathbench" | grep "not found"; then
@@ -60,6 +70,25 @@ bash "$suite/unpack.sh" > /dev/null || exit 5
   nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv
   lscpu | grep "Model name"
 } | tee "$out/machine.txt"
+summary="$out/summary-$label.txt"
+: > "$summary"
+if [ -f "$bins/pathbench_gpu_tests.xz" ]; then
+  xz -dc "$bins/pathbench_gpu_tests.xz" > /tmp/pb/pathbench_gpu_tests && chmod +x /tmp/pb/pathbench_gpu_tests || exit 3
+  src=${TESTS_SOURCE_DIR:-/work/main}
+  if [ ! -e "$src" ]; then mkdir -p "$(dirname "$src")" && ln -s "$(cd "$here/../.." && pwd)" "$src"; fi
+  (cd /tmp && timeout "${TESTS_BUDGET_S:-240}" /tmp/pb/pathbench_gpu_tests > "$out/gpu-tests-$label.txt" 2>&1)
+  rc=$?
+  echo "pathbench_gpu_tests rc=$rc: $(grep -E '^\[  PASSED  \]|^\[  FAILED  \] [0-9]+ test' "$out/gpu-tests-$label.txt" | tr '\n' ' ')" |
+    tee -a "$summary"
+fi
+if [ -n "${SANITIZE:-}" ]; then
+  for tool in memcheck racecheck; do
+    # shellcheck disable=SC2086
+    timeout 120 compute-sanitizer --tool "$tool" --print-limit 20 "/tmp/pb/$first/bin/pathbench" \
+      render --device gpu --quiet $SANITIZE --out /tmp/pb/sanitized.pfm > "$out/sanitizer-$label-$tool.txt" 2>&1
+    echo "compute-sanitizer $tool rc=$?: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$label-$tool.txt")" | tee -a "$summary"
+  done
+fi
 timeout "${BUDGET_S:-500}" bash "$here/gpu_variants_ab.sh" "$variants" "$cases" "/tmp/ab-$label" 2>&1 | tee "$out/ab-$label.txt"
 cp "/tmp/ab-$label/variants.tsv" "$out/ab-$label.tsv"
 echo "gpu_binaries_ab.sh: done at ${SECONDS}s"
