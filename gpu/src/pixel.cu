@@ -159,24 +159,22 @@ static_assert(kWideLatencyBlocks == 5 && kLeavesParkedBlocks == 5 && kLongPathBl
                   kPixelBigBvhBlocks == 6,
               "the counts compiled: 3, 5 and 8, and 6 for the binary BVH");
 
-// The scene's BVH exceeds the device's L2 of l2_bytes (the binary layout's nodes and
-// triangles): auto runs its megakernel at kPixelBigBvhBlocks with the path state parked
-// (strategies.cuh).
-bool big_binary_bvh(const GpuScene::Impl& g, uint64_t l2_bytes) {
-  if (g.bvh.kind != TraversalKind::Binary || g.bvh.binary.exact_ties) return false;
-  return g.bvh_bytes > l2_bytes;
-}
-
 // The traversal kind of the kernel run_pixel runs for the scene (with_traversal_kind: a binary
 // BVH with exact ties has kernels of its own), which the counts compiled are checked against.
 int kernel_kind(const GpuScene::Impl& g) {
   return with_traversal_kind(g.bvh, [](auto k) { return int(decltype(k)::value); });
 }
 
+// The scene's BVH exceeds the device's L2 of l2_bytes (the binary layout's nodes and
+// triangles; `kind`: kernel_kind): auto runs its megakernel at kPixelBigBvhBlocks with the
+// path state parked (strategies.cuh).
+bool big_binary_bvh(const GpuScene::Impl& g, int kind, uint64_t l2_bytes) {
+  return kind == int(TraversalKind::Binary) && g.bvh_bytes > l2_bytes;
+}
+
 // The block count PATHBENCH_GPU_PIXEL_BLOCKS or the scene's size and paths give (pixel_occupancy;
-// `big`: big_binary_bvh; `bounces`: the frame's, -1 unbounded).
-PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big, int32_t bounces) {
-  const int kind = kernel_kind(g);
+// `kind`: kernel_kind; `big`: big_binary_bvh; `bounces`: the frame's, -1 unbounded).
+PixelOccupancy pixel_blocks(const GpuScene::Impl& g, int kind, bool big, int32_t bounces) {
   const bool wide = kind == int(TraversalKind::Wide), binary = kind == int(TraversalKind::Binary);
   const int latency = wide ? kWideLatencyBlocks : kPixelLatencyBlocks;
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
@@ -218,15 +216,15 @@ PixelOccupancy pixel_blocks(const GpuScene::Impl& g, bool big, int32_t bounces) 
 }  // namespace
 
 PixelOccupancy pixel_occupancy(const GpuScene::Impl& g, uint64_t l2_bytes, uint32_t spp, int32_t bounces) {
-  const bool big = big_binary_bvh(g, l2_bytes);
-  PixelOccupancy o = pixel_blocks(g, big, bounces);
+  const int kind = kernel_kind(g);
+  const bool big = big_binary_bvh(g, kind, l2_bytes);
+  PixelOccupancy o = pixel_blocks(g, kind, big, bounces);
   const bool leaves = g.bvh.kind == TraversalKind::Leaves || g.bvh.kind == TraversalKind::Rects;  // rects: as leaves
   const char* env = std::getenv("PATHBENCH_GPU_PIXEL_PARKED");
   const std::string v = env ? env : "auto";
   if (v == "auto") o.parked = leaves || (o.min_blocks == kPixelBigBvhBlocks && big);
   else if (v == "0" || v == "1") o.parked = v == "1";
   else throw InputError(fmt::format("PATHBENCH_GPU_PIXEL_PARKED={}: expected auto, 0 or 1", v));
-  const int kind = kernel_kind(g);
   if (o.parked && !parked_compiled(kind, o.min_blocks)) o.parked = false;
   const char* blocks = std::getenv("PATHBENCH_GPU_PIXEL_BLOCKS");
   if (o.parked && leaves && (!blocks || std::string(blocks) == "auto")) {
