@@ -103,13 +103,17 @@ constexpr int kLeavesParkedBlocks = 5;
 //   8 blocks: paper-cornell-ico:5 at 4 and 8: 0.967, 0.965; bunny-armadillo 1.009 at 4, 0.979 at 8;
 //     glass-dragon at 8 0.986;
 //   6 parked (above the L2) at 8 bounces: ico:8 1.060, large-mesh 1.082: kept.
+// From 3 bounces, not 4, once short paths over meshes ran at 8 (below): at 3 bounces 5 blocks against
+// 8, paper-cornell-ico:2 0.985, ico:4 0.981 (docs/notes/gpu-log.md, "Short paths over meshes at 8
+// blocks").
 constexpr int kLongPathBlocks = 5;
-constexpr int32_t kLongPathBounces = 4, kLongPathLatencyBounces = 8;
+constexpr int32_t kLongPathBounces = 3, kLongPathLatencyBounces = 8;
 // Short paths (fewer than kLongPathBounces bounces) over a binary BVH below kPixelLatencyBoundTris:
 // kPixelLatencyBlocks from kPixelTinyTris triangles, 3 below. H200, 2 bounces, 8 blocks against 3
-// (docs/notes/gpu-log.md, "Long paths at 5 blocks"): paper-cornell-ico:1 (94 triangles) 0.960,
-// ico:2 (334) 0.954, ico:3 (1,294) 0.952, ico:4 (5,134) 0.924, ico:5 (20,494) 0.888; the tiniest
-// did not gain: cornell-box (38) 1.077, cornell-materials (50) 0.975 (5 blocks 1.064, 1.018).
+// (docs/notes/gpu-log.md, "Long paths at 5 blocks" and "Short paths over meshes at 8 blocks"):
+// paper-cornell-ico:1 (94 triangles) 0.960 / 0.962, ico:2 (334) 0.954 / 0.955, ico:3 (1,294) 0.952 /
+// 0.953, ico:4 (5,134) 0.924 / 0.923, ico:5 (20,494) 0.888; the tiniest did not all gain:
+// cornell-box (38) 1.077 / 1.078, cornell-materials (50) 0.975 / 0.973 (5 blocks 1.064, 1.018).
 constexpr uint32_t kPixelTinyTris = 64;
 // l2_bytes: the device's L2 (RenderSetup's DeviceInfo, the cache's copy where one is kept); spp:
 // the frame's samples a pixel (PixelOccupancy::lanes_ordered); bounces: the frame's max_bounces

@@ -236,7 +236,7 @@ TEST(GpuPixelOccupancy, BigBinaryBvhParkedAtSixBlocks) {
 }
 
 // auto's occupancy by path length on the binary BVH (strategies.cuh: kLongPathBlocks 5, from
-// kLongPathBounces 4 bounces below kPixelLatencyBoundTris triangles, else 8 from kPixelTinyTris 64
+// kLongPathBounces 3 bounces below kPixelLatencyBoundTris triangles, else 8 from kPixelTinyTris 64
 // triangles and 3 below; from kLongPathLatencyBounces 8 above, else 8), unbounded paths counted
 // long; a BVH beyond the L2 keeps kPixelBigBvhBlocks (6). The block count never changes the film.
 TEST(GpuPixelOccupancy, ByPathLength) {
@@ -248,8 +248,8 @@ TEST(GpuPixelOccupancy, ByPathLength) {
     int32_t bounces;
     int blocks;
   };
-  for (const Case& k : {Case{"cornell-box", 3, 3}, Case{"cornell-box", 4, 5}, Case{"cornell-box", -1, 5},
-                        Case{"paper-cornell-ico:2", 2, 8}, Case{"paper-cornell-ico:2", 4, 5},
+  for (const Case& k : {Case{"cornell-box", 2, 3}, Case{"cornell-box", 3, 5}, Case{"cornell-box", -1, 5},
+                        Case{"paper-cornell-ico:2", 2, 8}, Case{"paper-cornell-ico:2", 3, 5},
                         Case{"paper-cornell-ico:5", 7, 8}, Case{"paper-cornell-ico:5", 8, 5},
                         Case{"paper-cornell-ico:8", 8, 6}}) {
     const Scene scene = load_scene(k.scene);
