@@ -106,6 +106,23 @@ def test_u_test_verdicts_follow_compare():
     assert results.mann_whitney_p(a, [x + 100 for x in a]) < 1e-3
 
 
+def test_reference_machines_name_a_gpu_runs_gpu(tmp_path):
+    # Lent GPU hosts share one CPU model, so two GPUs' suite runs carry one machine name: the
+    # page's reference column must not show an H100's times under the name an H200 run has too.
+    def run(source, label, gpu, ms, bench):
+        head = {"run": {"preset": "suite", "source": source, "machine_name": "intel-r-xeon-r", "commit": "c",
+                        "run_date": "2026-11-27T00:56:29+00:00",
+                        "context": {"suite_device_label": label, "gpu_name": gpu, "machine": "intel-r-xeon-r"}}}
+        rows = [{"benchmark": bench, "unit": "ms", "value": v} for v in ms]
+        (tmp_path / f"{source}.jsonl").write_text("\n".join(json.dumps(x) for x in [head, *rows]) + "\n")
+    run("a-gpu.json", "gpu", "NVIDIA H100 80GB HBM3", [11.0, 12.0, 13.0], "suite/box/gpu/pixel/manual_time")
+    run("a-cpu.json", "cpu", "NVIDIA H100 80GB HBM3", [500.0], "suite/box/cpu/pixel/manual_time")
+    refs = results.reference_runs(str(tmp_path), "suite")
+    assert set(refs) == {"intel-r-xeon-r", "intel-r-xeon-r · NVIDIA H100 80GB HBM3"}
+    assert refs["intel-r-xeon-r · NVIDIA H100 80GB HBM3"]["suite/box/gpu/pixel"]["times_ms"] == [11.0, 12.0, 13.0]
+    assert list(refs["intel-r-xeon-r"]) == ["suite/box/cpu/pixel"]
+
+
 @needs_build
 def test_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path):
     out = tmp_path / "page"

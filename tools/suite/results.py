@@ -167,7 +167,8 @@ def previous_runs(db_path: str, sources: list[str], preset: str) -> dict[str, di
 
 def reference_runs(export_dir: str, preset: str, exclude_sources=()) -> dict[str, dict]:
     """machine name -> {benchmark: {times_ms, run_date, commit}} from the text export: each
-    reference machine's latest run of the preset, per benchmark."""
+    reference machine's latest run of the preset, per benchmark. A GPU run's machine is named
+    with its GPU ("intel-r-xeon-r · NVIDIA H100 80GB HBM3")."""
     refs: dict[str, dict] = {}
     for path in sorted(glob.glob(os.path.join(export_dir, "*.jsonl"))):
         try:
@@ -176,6 +177,11 @@ def reference_runs(export_dir: str, preset: str, exclude_sources=()) -> dict[str
                 if head.get("preset") != preset or head.get("source") in exclude_sources:
                     continue  # another preset, or this very run (recorded into the export just now)
                 name = head.get("machine_name") or head.get("machine_id", "?")
+                ctx = head.get("context") or {}
+                if str(ctx.get("suite_device_label", "")).startswith("gpu") and ctx.get("gpu_name"):
+                    # The machine's name is its host CPU's: a GPU run is another machine on the same
+                    # host model (an H100's and an H200's hosts are both "intel-r-xeon-r").
+                    name = f"{name} · {ctx['gpu_name']}"
                 date = head.get("run_date", "")
                 per = refs.setdefault(name, {})
                 for line in f:
