@@ -8,7 +8,9 @@
 # --clock-control none: the clocks stay as the benchmarks see them (METHOD.md); each
 # kernel launch is replayed by ncu, so the frames are small (the rates per kernel are
 # what counts, not the frame time) and at most LAUNCHES launches are profiled per run.
-# ROOFLINE_ONLY=REGEX runs only the runs whose name matches.
+# ROOFLINE_ONLY=REGEX runs only the runs whose name matches. ROOFLINE_RUNS=FILE adds runs, one a
+# line: "name | VAR=value ... | pathbench render arguments" (the variables set for that run
+# alone, "-" for none), e.g. one kernel at two occupancies by PATHBENCH_GPU_PIXEL_BLOCKS.
 set -uo pipefail
 build=${1:?usage: scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR}
 out=${2:?usage: scripts/device/gpu_roofline.sh BUILD_DIR OUT_DIR}
@@ -35,4 +37,12 @@ run paper-cornell-paper-queue --scene paper-cornell --strategy paper-queue --spp
 run ico8-pixel --scene paper-cornell-ico:8 --strategy pixel --spp 16 "${common[@]}"
 # Issue 32: the same megakernel on the wide BVH (ico8-pixel: the layout auto picks, binary).
 PATHBENCH_GPU_BVH=wide8 run ico8-wide8-pixel --scene paper-cornell-ico:8 --strategy pixel --spp 16 "${common[@]}"
+if [ -n "${ROOFLINE_RUNS:-}" ]; then
+  while IFS='|' read -r name vars args; do
+    read -r name <<< "$name"
+    [[ -z $name || $name == \#* ]] && continue
+    # shellcheck disable=SC2086  # the variables and arguments are words
+    (for v in $vars; do [ "$v" = - ] || export "${v?}"; done; run "$name" $args)
+  done < "$ROOFLINE_RUNS"
+fi
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem,power.limit --format=csv > "$out/nvidia-smi.csv"
