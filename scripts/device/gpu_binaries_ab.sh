@@ -82,11 +82,12 @@ if [ -f "$bins/pathbench_gpu_tests.xz" ]; then
     tee -a "$summary"
 fi
 if [ -n "${SANITIZE:-}" ]; then
+  # shellcheck source=scripts/device/sanitizer_run.sh
+  source "$here/sanitizer_run.sh"
   for tool in memcheck racecheck; do
-    # shellcheck disable=SC2086
-    timeout 120 compute-sanitizer --tool "$tool" --print-limit 20 "/tmp/pb/$first/bin/pathbench" \
-      render --device gpu --quiet $SANITIZE --out /tmp/pb/sanitized.pfm > "$out/sanitizer-$label-$tool.txt" 2>&1
-    echo "compute-sanitizer $tool rc=$?: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitizer-$label-$tool.txt")" | tee -a "$summary"
+    # shellcheck disable=SC2086  # SANITIZE: render arguments, as words
+    echo "compute-sanitizer $tool $(sanitizer_run "$out/sanitizer-$label-$tool.txt" "$tool" "/tmp/pb/$first/bin/pathbench" \
+      --device gpu --quiet $SANITIZE --out /tmp/pb/sanitized.pfm)" | tee -a "$summary"
   done
 fi
 timeout "${BUDGET_S:-500}" bash "$here/gpu_variants_ab.sh" "$variants" "$cases" "/tmp/ab-$label" 2>&1 | tee "$out/ab-$label.txt"

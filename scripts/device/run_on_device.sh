@@ -72,21 +72,16 @@ print(f"{name}: rc={rc} bvh {bvh.get('layout', '?')} device {j['device_seconds']
 PY
 }
 paper="--scene paper-cornell --width 256 --height 256 --spp 800 --bounces 2 --sampling nee"
-# One compute-sanitizer run of `pathbench render ARGS` into logs/sanitizer-NAME.txt; prints its
-# exit status and the tool's summary line.
-sanitizer_run() {  # NAME TOOL, then pathbench render arguments
-  local name=$1 tool=$2
-  shift 2
-  timeout 120 compute-sanitizer --tool "$tool" --print-limit 20 $PB render "$@" > "$OUT/logs/sanitizer-$name.txt" 2>&1
-  echo "rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$OUT/logs/sanitizer-$name.txt")"
-}
+# sanitizer_run LOG TOOL PATHBENCH ARGS: one compute-sanitizer run, its status and summary line.
+# shellcheck source=scripts/device/sanitizer_run.sh
+source scripts/device/sanitizer_run.sh
 
 if has sanitize; then
   small="--scene paper-cornell --width 32 --height 32 --spp 4 --bounces 2 --sampling nee --device gpu --quiet"
   for tool in memcheck racecheck; do
     for st in pixel wavefront paper-queue; do
       log "compute-sanitizer $tool $st"
-      sanitizer_run "$tool-$st" $tool $small --strategy $st --paths-in-flight 1000 | tee -a "$OUT/summary.txt"
+      sanitizer_run "$OUT/logs/sanitizer-$tool-$st.txt" $tool $PB $small --strategy $st --paths-in-flight 1000 | tee -a "$OUT/summary.txt"
     done
   done
   # The pixel megakernel's lanes ordered by the first bounce (sample_order.cuh: a counting sort
@@ -94,13 +89,13 @@ if has sanitize; then
   ordered="--scene paper-cornell-ico:2 --width 8 --height 8 --spp 300 --bounces 2 --sampling nee --device gpu --quiet"
   for tool in memcheck racecheck; do
     log "compute-sanitizer $tool pixel, lanes ordered"
-    PATHBENCH_GPU_BVH=binary PATHBENCH_GPU_PIXEL_BLOCKS=8 sanitizer_run "$tool-pixel-ordered" $tool $ordered --strategy pixel \
+    PATHBENCH_GPU_BVH=binary PATHBENCH_GPU_PIXEL_BLOCKS=8 sanitizer_run "$OUT/logs/sanitizer-$tool-pixel-ordered.txt" $tool $PB $ordered --strategy pixel \
       | tee -a "$OUT/summary.txt"
   done
   # Whole warps of one pixel (spp a multiple of 32: the film add by REDUX, device_film.cuh).
   for st in pixel wavefront; do
     log "compute-sanitizer memcheck $st, 64 spp"
-    sanitizer_run "memcheck-spp64-$st" memcheck ${small/--spp 4/--spp 64} --strategy $st --paths-in-flight 1000 \
+    sanitizer_run "$OUT/logs/sanitizer-memcheck-spp64-$st.txt" memcheck $PB ${small/--spp 4/--spp 64} --strategy $st --paths-in-flight 1000 \
       | tee -a "$OUT/summary.txt"
   done
 fi
@@ -215,7 +210,7 @@ PY
     export PATHBENCH_GPU_BVH=$l
     for tool in memcheck racecheck; do
       for st in pixel wavefront; do
-        echo "$l $tool $st: $(sanitizer_run "$tool-$st-$l" $tool $small_ico --strategy $st --paths-in-flight 1000)" \
+        echo "$l $tool $st: $(sanitizer_run "$OUT/logs/sanitizer-$tool-$st-$l.txt" $tool $PB $small_ico --strategy $st --paths-in-flight 1000)" \
           | tee -a "$OUT/summary.txt"
       done
     done
